@@ -1,0 +1,19 @@
+// Reading whole files and writing them atomically (temporary file + rename).
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "core/result.h"
+
+namespace wrap {
+
+/// Reads a whole file. Fails with kIo naming the path when it is missing or unreadable.
+Result<std::string> ReadFile(const std::filesystem::path& path);
+
+/// Writes `contents` to `path` atomically: a temporary file in the same folder is written,
+/// flushed to disk and renamed over `path`, so readers see the old or the new file, never a part.
+/// Fails with kIo (the old file, if any, is left untouched).
+Result<void> WriteFileAtomic(const std::filesystem::path& path, const std::string& contents);
+
+}  // namespace wrap

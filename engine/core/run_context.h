@@ -1,0 +1,80 @@
+// RunContext: what every pipeline stage receives besides its input and options.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <random>
+#include <stop_token>
+#include <string>
+
+namespace wrap {
+
+/// Per-stage wall-clock totals [s], keyed by stage name (e.g. "grasp", "fwd_search").
+using StageTimes = std::map<std::string, double>;
+
+/// Cancellation, deadline, progress, randomness and timing for one planner run. A run owns one
+/// context; stages check `ShouldStop()` in every loop that can take longer than ~50 ms.
+class RunContext {
+ public:
+  using Clock = std::chrono::steady_clock;
+  /// Progress sink: stage name, fraction done in [0, 1] (negative when unknown), short message.
+  using ProgressFn = std::function<void(const std::string&, double, const std::string&)>;
+
+  /// A context with no deadline, no stop token and a generator seeded with `seed`.
+  explicit RunContext(std::uint64_t seed = 0) : rng_(seed) {}
+
+  /// Cancels the run when `token` is signalled.
+  void set_stop_token(std::stop_token token) { stop_ = std::move(token); }
+  /// Gives up at `deadline`.
+  void set_deadline(Clock::time_point deadline) { deadline_ = deadline; }
+  /// Gives up `seconds` from now.
+  void set_time_limit_s(double seconds);
+  /// Receives progress reports.
+  void set_progress(ProgressFn fn) { progress_ = std::move(fn); }
+
+  /// True when cancelled.
+  bool cancelled() const { return stop_.stop_requested(); }
+  /// True when the deadline has passed.
+  bool timed_out() const { return Clock::now() >= deadline_; }
+  /// True when the run must stop now (cancelled or past its deadline).
+  bool ShouldStop() const { return cancelled() || timed_out(); }
+  /// Reports progress to the sink, if any.
+  void Progress(const std::string& stage, double fraction, const std::string& message) const {
+    if (progress_) progress_(stage, fraction, message);
+  }
+  /// The run's random generator: the only source of randomness in a run.
+  std::mt19937_64& rng() { return rng_; }
+  /// Accumulated seconds per stage.
+  const StageTimes& stage_times() const { return times_; }
+  /// Adds `seconds` to the total of `stage`.
+  void AddTime(const std::string& stage, double seconds) { times_[stage] += seconds; }
+
+ private:
+  std::stop_token stop_;
+  Clock::time_point deadline_ = Clock::time_point::max();
+  ProgressFn progress_;
+  std::mt19937_64 rng_;
+  StageTimes times_;
+};
+
+/// Adds the wall time of its scope to one stage of a RunContext.
+class ScopedStageTimer {
+ public:
+  ScopedStageTimer(RunContext& ctx, std::string stage)
+      : ctx_(ctx), stage_(std::move(stage)), start_(RunContext::Clock::now()) {}
+  ~ScopedStageTimer() {
+    ctx_.AddTime(stage_,
+                 std::chrono::duration<double>(RunContext::Clock::now() - start_).count());
+  }
+  ScopedStageTimer(const ScopedStageTimer&) = delete;
+  ScopedStageTimer& operator=(const ScopedStageTimer&) = delete;
+
+ private:
+  RunContext& ctx_;
+  std::string stage_;
+  RunContext::Clock::time_point start_;
+};
+
+}  // namespace wrap

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The README's commands: install the dependencies, build, then run the demo or the tests.
+#   scripts/dev.sh demo   install, build, and run the main job on the built-in stool example
+#   scripts/dev.sh test   install, build, and run the whole test suite (what CI runs)
+#   scripts/dev.sh build  install and build only
+# BUILD_DIR (default: build) and BUILD_TYPE (default: RelWithDebInfo) may be set.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+mode=${1:-demo}
+BUILD_DIR=${BUILD_DIR:-build}
+BUILD_TYPE=${BUILD_TYPE:-RelWithDebInfo}
+
+bash scripts/install_deps.sh
+cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE"
+cmake --build "$BUILD_DIR" --parallel "$(nproc)"
+
+case "$mode" in
+  build) ;;
+  demo)
+    "$BUILD_DIR/app/wrap" validate projects/stool.json
+    "$BUILD_DIR/app/wrap" info projects/stool.json
+    ;;
+  test)
+    ctest --test-dir "$BUILD_DIR" --output-on-failure --parallel "$(nproc)"
+    ;;
+  *)
+    echo "usage: scripts/dev.sh [demo|test|build]" >&2
+    exit 2
+    ;;
+esac
