@@ -196,6 +196,19 @@ TEST_F(ProjectFixture, WrongTypes) {
   ExpectError(lp, "robots[0].base_pose.xyz[1]", "expected a number");
 }
 
+TEST_F(ProjectFixture, DeeplyNestedJsonDoesNotCrash) {
+  const int depth = 200000;
+  const std::string text = std::string(depth, '[') + std::string(depth, ']');
+  const ProjectParse parse = ParseProject(text, "deep.json");
+  EXPECT_FALSE(parse.project);
+  EXPECT_TRUE(parse.diagnostics.has_errors());
+  // Deep nesting inside a valid project: reported as a wrong type, not a crash. (Built as
+  // text: nlohmann's dump() itself recurses.)
+  std::string doc = doc_.dump();
+  doc.insert(1, "\"description\": " + text + ", ");
+  ExpectError(Load(doc), "description", "expected a string");
+}
+
 TEST_F(ProjectFixture, TopLevelNotAnObject) {
   ExpectError(Load("[1, 2, 3]"), "", "expected a JSON object");
 }
