@@ -24,11 +24,15 @@ std::string JoinNames(const std::vector<T>& items) {
   return out;
 }
 
-// Husky dual-UR5e mount (../shared/robots ROBOTS.md §4.3, verified): the bulkhead at z 0.224 in
-// base_link, each arm base 0.1225 forward, 0.14891 to the side, 0.13371 up, rolled 45 deg outward.
+// Husky dual-UR5e mount (../shared/robots ROBOTS.md §4.2-4.3, verified): a mobile base's pose is
+// its footprint on the floor; base_link stands 0.13228 m above it, the bulkhead at z 0.224 in
+// base_link, each arm base 0.1225 forward, 0.14891 to the side, 0.13371 up, rolled 45 deg outward
+// (arm bases 0.490 m above the floor).
+constexpr double kHuskyBaseLinkHeight_m = 0.1651 - 0.03282;
+
 Pose HuskyMount(double side) {
   Pose p;
-  p.xyz = Vec3(0.1225, side * 0.14891, 0.224 + 0.13371);
+  p.xyz = Vec3(0.1225, side * 0.14891, kHuskyBaseLinkHeight_m + 0.224 + 0.13371);
   p.rpy = side > 0 ? Vec3(0.785398, 0.0, 3.14159) : Vec3(0.785398, 0.0, 0.0);
   return p;
 }

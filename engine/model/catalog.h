@@ -32,7 +32,8 @@ struct EndEffectorInfo {
 /// A mount point of a mobile-base preset.
 struct MountInfo {
   std::string name;  ///< e.g. "left".
-  Pose X_BM;         ///< Mount frame (robot base at identity base_pose) in base_link.
+  Pose X_BM;         ///< Mount frame (robot base at identity base_pose) in the base frame,
+                     ///< which lies on the floor under the base's centre.
 };
 
 /// Catalog facts about a mobile-base preset.

@@ -364,8 +364,8 @@ TEST_F(ProjectFixture, HuskyMountPlacesArmsHalfAMetreUp) {
   const LoadedProject lp = Load();
   const Iso3 X = RobotBaseInWorld(*lp.project, lp.project->robots[0]);
   // ROBOTS.md §4.3 (derived): left base at (0.1225, 0.14891, 0.35771) in base_link, which
-  // stands 0.1323 m above the ground, z axis tilted 45 deg outward (0, 0.707, 0.707).
-  EXPECT_TRUE(X.translation().isApprox(Vec3(0.1225, 0.14891, 0.35771), 1e-4));
+  // stands 0.13228 m above the ground (0.490 m in all), z axis tilted 45 deg outward.
+  EXPECT_TRUE(X.translation().isApprox(Vec3(0.1225, 0.14891, 0.48999), 1e-4));
   EXPECT_TRUE(X.linear().col(2).isApprox(Vec3(0, 0.70711, 0.70711), 1e-4));
 }
 
