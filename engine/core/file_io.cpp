@@ -52,8 +52,12 @@ Result<void> WriteFileAtomic(const fs::path& path, const std::string& contents) 
     p += n;
     left -= static_cast<size_t>(n);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const std::string why = std::strerror(errno);
+  // Always close, even when fsync fails, so the descriptor never leaks.
+  const bool synced = ::fsync(fd) == 0;
+  const int sync_errno = errno;
+  const bool closed = ::close(fd) == 0;
+  if (!synced || !closed) {
+    const std::string why = std::strerror(synced ? errno : sync_errno);
     ::unlink(tmp.c_str());
     return Fail(ErrorCode::kIo, "cannot flush '" + tmp.string() + "': " + why);
   }

@@ -23,7 +23,9 @@ struct MeshImportOptions {
 /// Coordinates are taken as written, times `scale`: node transforms (glTF, DAE, 3MF build items)
 /// are applied, a COLLADA up axis is ignored (a Z-up file stays Z-up), but a COLLADA `<unit>` is
 /// applied by assimp (such files come in metres). Points and lines are dropped, and so are
-/// triangles whose corners weld together. Never throws, whatever the file holds.
+/// triangles whose corners weld together. Does not throw; damaged files on which assimp 5.2 is
+/// known to hang or abort are rejected before it reads them, but assimp is not proof against
+/// every hostile file (mesh_import.cpp lists what fuzzing found).
 Result<TriangleMesh> ImportMesh(const std::filesystem::path& path,
                                 const MeshImportOptions& options = {});
 
