@@ -4,8 +4,8 @@
 #include <string>
 
 #include "cli.h"
+#include "load.h"
 #include "model/catalog.h"
-#include "model/validate.h"
 
 namespace wrap::cli {
 
@@ -67,7 +67,7 @@ void PrintNode(const Project& p, const AssemblyTree& tree, int id, const std::st
 }  // namespace
 
 int Info(const std::string& project, std::ostream& out, std::ostream& err) {
-  const LoadedProject loaded = LoadProject(project);
+  const LoadedProject loaded = LoadChecked(project);
   const Diagnostics& diags = loaded.check.diagnostics;
   if (!loaded.ok()) {
     for (const Diagnostic& d : diags.items) err << Format(d) << "\n";
@@ -81,8 +81,8 @@ int Info(const std::string& project, std::ostream& out, std::ostream& err) {
   out << "Project '" << p.name << "' (" << project << ")\n";
   if (!p.description.empty()) out << "  " << p.description << "\n";
   out << "\nTable: " << Fmt("%.2f", p.table.size.x()) << " x " << Fmt("%.2f", p.table.size.y())
-      << " m, top at z = " << Fmt("%.3f", p.table.height)
-      << " m, friction " << Fmt("%.2f", p.table.friction) << "\n";
+      << " m, top at z = " << Fmt("%.3f", p.table.height) << " m, friction "
+      << Fmt("%.2f", p.table.friction) << "\n";
 
   out << "\nParts (" << p.parts.size() << "):\n";
   out << "  " << Pad("name", 18) << Pad("mass [kg]", 11) << Pad("size [mm]", 26)
@@ -114,11 +114,8 @@ int Info(const std::string& project, std::ostream& out, std::ostream& err) {
     const EndEffectorInfo* ee = FindEndEffector(r.end_effector);
     char base[96];
     std::snprintf(base, sizeof base, "base (%.3f, %.3f, %.3f) m", t.x(), t.y(), t.z());
-    out << "  " << Pad(r.name, 12) << Pad(model, 46) << Pad(r.end_effector + " (" +
-                                                                std::string(ToString(ee->kind)) +
-                                                                ")",
-                                                            30)
-        << base;
+    out << "  " << Pad(r.name, 12) << Pad(model, 46)
+        << Pad(r.end_effector + " (" + std::string(ToString(ee->kind)) + ")", 30) << base;
     if (!r.mounted_on.empty()) out << " on " << r.mounted_on << "/" << r.mount;
     out << "\n";
   }

@@ -1,7 +1,7 @@
 #include <ostream>
 
 #include "cli.h"
-#include "model/validate.h"
+#include "load.h"
 
 namespace wrap::cli {
 
@@ -17,7 +17,7 @@ void PrintDiagnostics(const Diagnostics& diags, bool errors_only, std::ostream& 
 }  // namespace
 
 int Validate(const std::string& project, bool quiet, std::ostream& out, std::ostream& err) {
-  const LoadedProject loaded = LoadProject(project);
+  const LoadedProject loaded = LoadChecked(project);
   const Diagnostics& diags = loaded.check.diagnostics;
   PrintDiagnostics(diags, quiet, err);
   if (!loaded.ok()) {
@@ -29,9 +29,8 @@ int Validate(const std::string& project, bool quiet, std::ostream& out, std::ost
   }
   if (!quiet) {
     const Project& p = *loaded.project;
-    out << project << ": valid: " << p.parts.size() << " parts, " << p.steps.size()
-        << " steps, " << p.robots.size() << " robots, " << diags.warning_count()
-        << " warning(s)\n";
+    out << project << ": valid: " << p.parts.size() << " parts, " << p.steps.size() << " steps, "
+        << p.robots.size() << " robots, " << diags.warning_count() << " warning(s)\n";
   }
   return 0;
 }

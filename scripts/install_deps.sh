@@ -8,10 +8,12 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   # engine: math, mesh import, project files, command line
   libeigen3-dev libassimp-dev nlohmann-json3-dev libcli11-dev
+  # robots: collision (FCL + libccd), URDF import
+  libfcl-dev libccd-dev liburdfdom-dev
   # ui: GL, offscreen contexts (EGL, OSMesa), window and widgets
   libgl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libimgui-dev
-  # tests
-  libgtest-dev
+  # tests and benchmarks
+  libgtest-dev libbenchmark-dev
 )
 
 missing=()

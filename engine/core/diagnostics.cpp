@@ -20,9 +20,7 @@ int Diagnostics::error_count() const {
   }));
 }
 
-int Diagnostics::warning_count() const {
-  return static_cast<int>(items.size()) - error_count();
-}
+int Diagnostics::warning_count() const { return static_cast<int>(items.size()) - error_count(); }
 
 void Diagnostics::Append(const Diagnostics& other) {
   items.insert(items.end(), other.items.begin(), other.items.end());

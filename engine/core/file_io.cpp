@@ -31,9 +31,8 @@ Result<std::string> ReadFile(const fs::path& path) {
 Result<void> WriteFileAtomic(const fs::path& path, const std::string& contents) {
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::random_device rd;
-  const fs::path tmp =
-      dir / ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" +
-             std::to_string(rd() & 0xffffff));
+  const fs::path tmp = dir / ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) +
+                              "_" + std::to_string(rd() & 0xffffff));
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) {
     return Fail(ErrorCode::kIo, "cannot create '" + tmp.string() + "': " + std::strerror(errno));
@@ -64,8 +63,8 @@ Result<void> WriteFileAtomic(const fs::path& path, const std::string& contents) 
   if (::rename(tmp.c_str(), path.c_str()) != 0) {
     const std::string why = std::strerror(errno);
     ::unlink(tmp.c_str());
-    return Fail(ErrorCode::kIo, "cannot rename '" + tmp.string() + "' to '" + path.string() +
-                                    "': " + why);
+    return Fail(ErrorCode::kIo,
+                "cannot rename '" + tmp.string() + "' to '" + path.string() + "': " + why);
   }
   return {};
 }

@@ -7,8 +7,8 @@ void RunContext::set_time_limit_s(double seconds) {
     deadline_ = Clock::time_point::max();
     return;
   }
-  deadline_ = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                 std::chrono::duration<double>(seconds));
+  deadline_ = Clock::now() +
+              std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
 }  // namespace wrap

@@ -65,8 +65,7 @@ class ScopedStageTimer {
   ScopedStageTimer(RunContext& ctx, std::string stage)
       : ctx_(ctx), stage_(std::move(stage)), start_(RunContext::Clock::now()) {}
   ~ScopedStageTimer() {
-    ctx_.AddTime(stage_,
-                 std::chrono::duration<double>(RunContext::Clock::now() - start_).count());
+    ctx_.AddTime(stage_, std::chrono::duration<double>(RunContext::Clock::now() - start_).count());
   }
   ScopedStageTimer(const ScopedStageTimer&) = delete;
   ScopedStageTimer& operator=(const ScopedStageTimer&) = delete;

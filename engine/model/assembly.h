@@ -11,12 +11,12 @@ namespace wrap {
 
 /// One vertex of the DAG: a part (a leaf) or the subassembly a step builds.
 struct AssemblyNode {
-  std::string name;           ///< Part or step name.
-  int part = -1;              ///< Index into Project::parts for a leaf, else -1.
-  int step = -1;              ///< Index into Project::steps for a step, else -1.
-  std::vector<int> inputs;    ///< Node ids of the step's inputs (empty for a part).
-  std::vector<int> parts;     ///< Indices of every part in this subassembly, ascending.
-  int consumer = -1;          ///< Node id of the step that uses this node as input; -1 for root.
+  std::string name;         ///< Part or step name.
+  int part = -1;            ///< Index into Project::parts for a leaf, else -1.
+  int step = -1;            ///< Index into Project::steps for a step, else -1.
+  std::vector<int> inputs;  ///< Node ids of the step's inputs (empty for a part).
+  std::vector<int> parts;   ///< Indices of every part in this subassembly, ascending.
+  int consumer = -1;        ///< Node id of the step that uses this node as input; -1 for root.
 };
 
 /// The DAG with parts and steps as nodes. Node ids: parts first (same order as

@@ -23,8 +23,8 @@ struct RobotModelInfo {
 
 /// Catalog facts about an end effector.
 struct EndEffectorInfo {
-  std::string name;          ///< Catalog key, e.g. "robotiq_2f85".
-  std::string title;         ///< Display name.
+  std::string name;                                    ///< Catalog key, e.g. "robotiq_2f85".
+  std::string title;                                   ///< Display name.
   EndEffectorKind kind = EndEffectorKind::kTwoFinger;  ///< Decides grasps and wrench model.
   double tcp_offset_m = 0.0;  ///< Flange to TCP along the approach axis [m].
 };
@@ -38,9 +38,9 @@ struct MountInfo {
 
 /// Catalog facts about a mobile-base preset.
 struct MobileBaseInfo {
-  std::string name;                ///< Catalog key, e.g. "husky_dual_ur5e".
-  std::string title;               ///< Display name.
-  std::vector<MountInfo> mounts;   ///< Where arms attach.
+  std::string name;               ///< Catalog key, e.g. "husky_dual_ur5e".
+  std::string title;              ///< Display name.
+  std::vector<MountInfo> mounts;  ///< Where arms attach.
 };
 
 /// All robot models, end effectors and base presets known to this build.

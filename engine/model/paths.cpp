@@ -42,8 +42,7 @@ Result<ResolvedPath> ResolveProjectPath(const Project& project, const fs::path& 
       // A default is relative to the project file; keep it that way when expanded.
       value = var.default_value;
       out.explanation += "${" + name + "} = '" + value + "' (default" +
-                         (var.env.empty() ? std::string(")")
-                                          : "; $" + var.env + " not set)");
+                         (var.env.empty() ? std::string(")") : "; $" + var.env + " not set)");
     }
     if (!var.hint.empty()) out.hint = var.hint;
     expanded += value;

@@ -26,16 +26,16 @@ struct WrenchBox {
 
 /// One rigid part: a mesh and where it is before and after assembly.
 struct Part {
-  std::string name;                      ///< Unique among parts and steps.
-  std::string mesh;                      ///< Mesh path as written (relative to the project file;
-                                         ///< may use ${NAME} from Project::paths).
-  double scale = 1.0;                    ///< Mesh units to metres (0.001 for mm, 0.01 for cm).
-  std::optional<double> mass_kg;         ///< Mass [kg]; when absent, density * mesh volume.
-  double density_kg_m3 = 1240.0;         ///< Density [kg/m^3] (PLA) used when mass is absent.
-  Pose assembled_pose;                   ///< X_AP: part frame in the assembly frame (default
-                                         ///< identity: the mesh is modelled in place).
-  Pose initial_pose;                     ///< X_WP: part frame in the world, resting on the table.
-  Rgba color = {0.8, 0.8, 0.8, 1.0};     ///< Display colour.
+  std::string name;                   ///< Unique among parts and steps.
+  std::string mesh;                   ///< Mesh path as written (relative to the project file;
+                                      ///< may use ${NAME} from Project::paths).
+  double scale = 1.0;                 ///< Mesh units to metres (0.001 for mm, 0.01 for cm).
+  std::optional<double> mass_kg;      ///< Mass [kg]; when absent, density * mesh volume.
+  double density_kg_m3 = 1240.0;      ///< Density [kg/m^3] (PLA) used when mass is absent.
+  Pose assembled_pose;                ///< X_AP: part frame in the assembly frame (default
+                                      ///< identity: the mesh is modelled in place).
+  Pose initial_pose;                  ///< X_WP: part frame in the world, resting on the table.
+  Rgba color = {0.8, 0.8, 0.8, 1.0};  ///< Display colour.
   bool operator==(const Part&) const = default;
 };
 
@@ -88,13 +88,15 @@ struct MobileBase {
 
 /// One robot arm with its end effector.
 struct Robot {
-  std::string name;                  ///< Unique robot name.
-  std::string model;                 ///< Catalog model ("ur5e", "ur10e", "openarm"); empty if urdf.
-  std::string urdf;                  ///< URDF path relative to the project file; empty if model.
-  std::string end_effector;          ///< Catalog end effector ("robotiq_2f85", "vacuum_cup", ...).
-  std::string mounted_on;            ///< Name of a mobile base, or empty for the world.
-  std::string mount;                 ///< Mount point on that base ("left", "right").
-  Pose base_pose;                    ///< Robot base in the world, or in the mount frame.
+  std::string name;          ///< Unique robot name.
+  std::string model;         ///< Catalog model ("ur5e", "ur10e", "openarm"); empty if urdf.
+  std::string urdf;          ///< URDF path relative to the project file; empty if model.
+  std::string urdf_root;     ///< URDF: base link of the chain (empty: the URDF's root).
+  std::string urdf_tip;      ///< URDF: tip link = flange (empty: the only tip).
+  std::string end_effector;  ///< Catalog end effector ("robotiq_2f85", "vacuum_cup", ...).
+  std::string mounted_on;    ///< Name of a mobile base, or empty for the world.
+  std::string mount;         ///< Mount point on that base ("left", "right").
+  Pose base_pose;            ///< Robot base in the world, or in the mount frame.
   std::optional<WrenchLimits> wrench_limits;  ///< Overrides the project's limits for this robot.
   bool operator==(const Robot&) const = default;
 };
@@ -130,17 +132,17 @@ struct PathVariable {
 struct Project {
   static constexpr int kFormatVersion = 1;  ///< The version this build reads and writes.
 
-  std::string name;                            ///< Display name.
-  std::string description;                     ///< Free text.
-  std::map<std::string, PathVariable> paths;   ///< Path variables for meshes and URDFs.
-  std::vector<Part> parts;                     ///< The parts, in file order.
-  std::vector<Step> steps;                     ///< The dependency DAG as steps, in file order.
+  std::string name;                           ///< Display name.
+  std::string description;                    ///< Free text.
+  std::map<std::string, PathVariable> paths;  ///< Path variables for meshes and URDFs.
+  std::vector<Part> parts;                    ///< The parts, in file order.
+  std::vector<Step> steps;                    ///< The dependency DAG as steps, in file order.
   WrenchBox connection_limits{Vec3(200.0, 200.0, 200.0), Vec3(10.0, 10.0, 10.0)};  ///< T_pq.
-  WrenchLimits wrench_limits;                  ///< End-effector limits for all robots.
-  std::vector<MobileBase> mobile_bases;        ///< Bases robots can be mounted on.
-  std::vector<Robot> robots;                   ///< The robots around the table.
-  Table table;                                 ///< The table.
-  PlannerDefaults planner;                     ///< Planner defaults.
+  WrenchLimits wrench_limits;            ///< End-effector limits for all robots.
+  std::vector<MobileBase> mobile_bases;  ///< Bases robots can be mounted on.
+  std::vector<Robot> robots;             ///< The robots around the table.
+  Table table;                           ///< The table.
+  PlannerDefaults planner;               ///< Planner defaults.
   bool operator==(const Project&) const = default;
 };
 

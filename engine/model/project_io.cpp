@@ -109,9 +109,10 @@ class Reader {
     const json* j = Member(obj, path, key, false);
     if (!j) return;
     if (!j->is_number_integer()) {
-      Error(Join(path, key), "expected an integer, found " + (j->is_number() ? std::string("a "
-                                                                              "fraction")
-                                                                            : TypeName(*j)));
+      Error(Join(path, key),
+            "expected an integer, found " + (j->is_number() ? std::string("a "
+                                                                          "fraction")
+                                                            : TypeName(*j)));
       return;
     }
     out = j->get<long long>();
@@ -157,8 +158,7 @@ class Reader {
   bool Numbers(const json& j, const std::string& path, double* out, size_t n) {
     if (!j.is_array() || j.size() != n) {
       Error(path, "expected an array of " + std::to_string(n) + " numbers, found " +
-                      (j.is_array() ? "an array of " + std::to_string(j.size())
-                                    : TypeName(j)));
+                      (j.is_array() ? "an array of " + std::to_string(j.size()) : TypeName(j)));
       return false;
     }
     bool ok = true;
@@ -304,11 +304,13 @@ void ReadWrenchLimits(Reader& r, const json& j, const std::string& path, WrenchL
 void ReadRobot(Reader& r, const json& j, const std::string& path, Robot& robot) {
   if (!r.Object(j, path)) return;
   r.CheckKeys(j, path,
-              {"name", "model", "urdf", "end_effector", "mounted_on", "mount", "base_pose",
-               "wrench_limits"});
+              {"name", "model", "urdf", "urdf_root", "urdf_tip", "end_effector", "mounted_on",
+               "mount", "base_pose", "wrench_limits"});
   r.String(j, path, "name", robot.name, true);
   r.String(j, path, "model", robot.model);
   r.String(j, path, "urdf", robot.urdf);
+  r.String(j, path, "urdf_root", robot.urdf_root);
+  r.String(j, path, "urdf_tip", robot.urdf_tip);
   r.String(j, path, "end_effector", robot.end_effector, true);
   r.String(j, path, "mounted_on", robot.mounted_on);
   r.String(j, path, "mount", robot.mount);
@@ -396,7 +398,7 @@ std::string CleanJsonMessage(const std::string& what) {
 
 ojson PoseJson(const Pose& p) {
   return ojson{{"xyz", {p.xyz.x(), p.xyz.y(), p.xyz.z()}},
-              {"rpy", {p.rpy.x(), p.rpy.y(), p.rpy.z()}}};
+               {"rpy", {p.rpy.x(), p.rpy.y(), p.rpy.z()}}};
 }
 
 ojson Vec3Json(const Vec3& v) { return ojson::array({v.x(), v.y(), v.z()}); }
@@ -407,8 +409,8 @@ ojson WrenchBoxJson(const WrenchBox& b) {
 
 ojson WrenchLimitsJson(const WrenchLimits& w) {
   return ojson{{"two_finger", WrenchBoxJson(w.two_finger)},
-              {"vacuum_assembly", WrenchBoxJson(w.vacuum_assembly)},
-              {"vacuum_transport", WrenchBoxJson(w.vacuum_transport)}};
+               {"vacuum_assembly", WrenchBoxJson(w.vacuum_assembly)},
+               {"vacuum_transport", WrenchBoxJson(w.vacuum_transport)}};
 }
 
 }  // namespace
@@ -513,9 +515,9 @@ std::string SerializeProject(const Project& p) {
     root["paths"] = paths;
   }
   root["table"] = ojson{{"size", Vec3Json(p.table.size)},
-                       {"center_xy", {p.table.center_xy.x(), p.table.center_xy.y()}},
-                       {"height", p.table.height},
-                       {"friction", p.table.friction}};
+                        {"center_xy", {p.table.center_xy.x(), p.table.center_xy.y()}},
+                        {"height", p.table.height},
+                        {"friction", p.table.friction}};
   ojson parts = ojson::array();
   for (const Part& part : p.parts) {
     ojson j{{"name", part.name}, {"mesh", part.mesh}, {"scale", part.scale}};
@@ -530,14 +532,10 @@ std::string SerializeProject(const Project& p) {
   ojson steps = ojson::array();
   for (const Step& s : p.steps) {
     const Mating& m = s.mating;
-    ojson mj{{"moved", m.moved},
-            {"base", m.base},
-            {"axis", Vec3Json(m.axis)},
-            {"force_N", m.force_N},
-            {"torque_Nm", m.torque_Nm},
-            {"transverse_fraction", m.transverse_fraction},
-            {"offset_m", m.offset_m},
-            {"approach_m", m.approach_m}};
+    ojson mj{{"moved", m.moved},         {"base", m.base},
+             {"axis", Vec3Json(m.axis)}, {"force_N", m.force_N},
+             {"torque_Nm", m.torque_Nm}, {"transverse_fraction", m.transverse_fraction},
+             {"offset_m", m.offset_m},   {"approach_m", m.approach_m}};
     if (!m.final_poses.empty()) {
       ojson fp = ojson::array();
       for (const Pose& pose : m.final_poses) fp.push_back(PoseJson(pose));
@@ -564,6 +562,8 @@ std::string SerializeProject(const Project& p) {
     ojson j{{"name", rb.name}};
     if (!rb.model.empty()) j["model"] = rb.model;
     if (!rb.urdf.empty()) j["urdf"] = rb.urdf;
+    if (!rb.urdf_root.empty()) j["urdf_root"] = rb.urdf_root;
+    if (!rb.urdf_tip.empty()) j["urdf_tip"] = rb.urdf_tip;
     j["end_effector"] = rb.end_effector;
     if (!rb.mounted_on.empty()) j["mounted_on"] = rb.mounted_on;
     if (!rb.mount.empty()) j["mount"] = rb.mount;
@@ -573,9 +573,9 @@ std::string SerializeProject(const Project& p) {
   }
   root["robots"] = robots;
   root["planner"] = ojson{{"grasps", p.planner.grasps},
-                         {"widen_grasps", p.planner.widen_grasps},
-                         {"time_limit_s", p.planner.time_limit_s},
-                         {"seed", p.planner.seed}};
+                          {"widen_grasps", p.planner.widen_grasps},
+                          {"time_limit_s", p.planner.time_limit_s},
+                          {"seed", p.planner.seed}};
   // Keys keep the order written here (ordered_json): format and version first.
   return root.dump(2) + "\n";
 }

@@ -16,10 +16,10 @@ namespace fs = std::filesystem;
 namespace {
 
 // Thresholds of the plausibility warnings.
-constexpr double kMaxPartSize_m = 5.0;     // Larger: probably mm read as m.
-constexpr double kMinPartSize_m = 0.001;   // Smaller: probably m read as mm.
-constexpr double kRestTolerance_m = 0.002; // Lowest point this close to the table top rests.
-constexpr int kMinReachingRobots = 2;      // Handovers and bracing need two robots.
+constexpr double kMaxPartSize_m = 5.0;      // Larger: probably mm read as m.
+constexpr double kMinPartSize_m = 0.001;    // Smaller: probably m read as mm.
+constexpr double kRestTolerance_m = 0.002;  // Lowest point this close to the table top rests.
+constexpr int kMinReachingRobots = 2;       // Handovers and bracing need two robots.
 
 std::string Num(double v) {
   std::ostringstream ss;
@@ -89,8 +89,8 @@ class Checker {
     CheckRobots();
     CheckReach();
     if (!(p_.planner.time_limit_s > 0.0) || !std::isfinite(p_.planner.time_limit_s)) {
-      Error("planner.time_limit_s", "must be a positive finite number of seconds, found " +
-                                        Num(p_.planner.time_limit_s));
+      Error("planner.time_limit_s",
+            "must be a positive finite number of seconds, found " + Num(p_.planner.time_limit_s));
     }
   }
 
@@ -134,15 +134,16 @@ class Checker {
         continue;
       }
       auto [it, fresh] = robots.emplace(p_.robots[i].name, path);
-      if (!fresh) Error(path, "robot name " + Quote(p_.robots[i].name) + " is already used at " +
-                                  it->second);
+      if (!fresh)
+        Error(path, "robot name " + Quote(p_.robots[i].name) + " is already used at " + it->second);
     }
     std::map<std::string, std::string> bases;
     for (size_t i = 0; i < p_.mobile_bases.size(); ++i) {
       const std::string path = "mobile_bases[" + std::to_string(i) + "].name";
       auto [it, fresh] = bases.emplace(p_.mobile_bases[i].name, path);
-      if (!fresh) Error(path, "mobile base name " + Quote(p_.mobile_bases[i].name) +
-                                  " is already used at " + it->second);
+      if (!fresh)
+        Error(path, "mobile base name " + Quote(p_.mobile_bases[i].name) + " is already used at " +
+                        it->second);
     }
   }
 
@@ -174,8 +175,8 @@ class Checker {
     geo.resolved = resolved->path;
     std::error_code ec;
     if (!fs::exists(resolved->path, ec)) {
-      std::string msg = "file " + Quote(part.mesh) + " not found (resolved to " +
-                        resolved->path.string();
+      std::string msg =
+          "file " + Quote(part.mesh) + " not found (resolved to " + resolved->path.string();
       if (!resolved->explanation.empty()) msg += "; " + resolved->explanation;
       msg += ")";
       if (!resolved->hint.empty()) msg += "; " + resolved->hint;
@@ -196,10 +197,10 @@ class Checker {
     const Vec3 size = geo.aabb.size();
     const int tri = static_cast<int>(geo.mesh.triangles.size());
     if (geo.topology.degenerate_triangles == tri || size.minCoeff() <= 0.0) {
-      Error(path + ".mesh", "mesh " + Quote(part.mesh) +
-                                " is degenerate (all triangles have zero area or it is flat: " +
-                                "size " + Num(size.x()) + " x " + Num(size.y()) + " x " +
-                                Num(size.z()) + " m)");
+      Error(path + ".mesh",
+            "mesh " + Quote(part.mesh) +
+                " is degenerate (all triangles have zero area or it is flat: " + "size " +
+                Num(size.x()) + " x " + Num(size.y()) + " x " + Num(size.z()) + " m)");
       return;
     }
     geo.loaded = true;
@@ -311,8 +312,8 @@ class Checker {
       const MobileBase& b = p_.mobile_bases[i];
       const std::string path = "mobile_bases[" + std::to_string(i) + "]";
       if (!FindMobileBasePreset(b.model)) {
-        Error(path + ".model",
-              "unknown mobile base " + Quote(b.model) + " (known: " + MobileBasePresetNames() + ")");
+        Error(path + ".model", "unknown mobile base " + Quote(b.model) +
+                                   " (known: " + MobileBasePresetNames() + ")");
       }
       PoseOk(b.pose, path + ".pose");
     }

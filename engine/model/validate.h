@@ -15,13 +15,13 @@ namespace wrap {
 
 /// A part's mesh as loaded for validation, with the facts `wrap info` shows.
 struct PartGeometry {
-  bool loaded = false;               ///< The mesh was read and has triangles.
-  std::filesystem::path resolved;    ///< The file that was opened.
-  TriangleMesh mesh;                 ///< In metres, in the part frame.
-  MeshTopology topology;             ///< Closedness and degeneracy.
-  MassProperties mass_properties;    ///< Per unit density (valid when closed).
-  Aabb aabb;                         ///< Bounding box in the part frame [m].
-  double mass_kg = 0.0;              ///< Given mass, or density times volume.
+  bool loaded = false;             ///< The mesh was read and has triangles.
+  std::filesystem::path resolved;  ///< The file that was opened.
+  TriangleMesh mesh;               ///< In metres, in the part frame.
+  MeshTopology topology;           ///< Closedness and degeneracy.
+  MassProperties mass_properties;  ///< Per unit density (valid when closed).
+  Aabb aabb;                       ///< Bounding box in the part frame [m].
+  double mass_kg = 0.0;            ///< Given mass, or density times volume.
 };
 
 /// Options of ValidateProject.
@@ -31,9 +31,9 @@ struct ValidationOptions {
 
 /// What validation found.
 struct ProjectCheck {
-  Diagnostics diagnostics;             ///< All problems (errors and warnings).
-  std::vector<PartGeometry> parts;     ///< One per Project::parts entry.
-  std::optional<AssemblyTree> tree;    ///< The DAG, when it is well formed.
+  Diagnostics diagnostics;           ///< All problems (errors and warnings).
+  std::vector<PartGeometry> parts;   ///< One per Project::parts entry.
+  std::optional<AssemblyTree> tree;  ///< The DAG, when it is well formed.
 };
 
 /// Checks everything a planner run relies on (see README "Validation"): numbers positive and

@@ -84,6 +84,46 @@ TEST(Cli, ValidateReportsEveryProblemOnStderr) {
   EXPECT_NE(r.err.find("3 error(s)"), std::string::npos) << r.err;
 }
 
+// A project whose robots come from URDF files: validation imports them and reports their
+// problems at the robot's JSON path.
+TEST(Cli, ValidateImportsUrdfRobots) {
+  const std::string joint =
+      R"(type="revolute"><limit lower="-1" upper="1" velocity="1" effort="1"/>)";
+  auto urdf = [&](const std::string& name, bool two_tips) {
+    std::string t = "<robot name=\"" + name + "\"><link name=\"base\"/><link name=\"a\"/>";
+    t += "<link name=\"b\"/><joint name=\"j1\" " + joint +
+         "<parent link=\"base\"/><child link=\"a\"/></joint>";
+    t += "<joint name=\"j2\" " + joint + "<parent link=\"a\"/><child link=\"b\"/></joint>";
+    if (two_tips) {
+      t += "<link name=\"c\"/><joint name=\"j3\" " + joint +
+           "<parent link=\"a\"/><child link=\"c\"/></joint>";
+    }
+    return t + "</robot>";
+  };
+  TempFile("good_arm.urdf", urdf("good", false));
+  TempFile("forked_arm.urdf", urdf("forked", true));
+  const std::string mesh = (fs::path(WRAP_SOURCE_DIR) / "assets/parts/cross/arm.obj").string();
+  auto project = [&](const std::string& urdf_file, const std::string& extra) {
+    return R"({"format": "wrap-project", "version": 1,
+      "parts": [{"name": "a", "mesh": ")" +
+           mesh + R"(", "scale": 0.001, "initial_pose": {"xyz": [0, 0, 0.78]}}],
+      "robots": [{"name": "r", "urdf": ")" +
+           urdf_file + R"(", "end_effector": "vacuum_cup")" + extra + "}]}";
+  };
+  CliRun r = Wrap({"validate", TempFile("urdf_good.json", project("good_arm.urdf", "")).string()});
+  EXPECT_EQ(r.code, 0) << r.err;
+  r = Wrap({"validate", TempFile("urdf_forked.json", project("forked_arm.urdf", "")).string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("robots[0].urdf: error: cannot use URDF 'forked_arm.urdf'"),
+            std::string::npos)
+      << r.err;
+  // Naming the tip resolves it.
+  r = Wrap(
+      {"validate",
+       TempFile("urdf_tip.json", project("forked_arm.urdf", R"(, "urdf_tip": "c")")).string()});
+  EXPECT_EQ(r.code, 0) << r.err;
+}
+
 TEST(Cli, InfoShowsPartsTreeAndRobots) {
   const CliRun r = Wrap({"info", Project("stool")});
   ASSERT_EQ(r.code, 0) << r.err;

@@ -140,12 +140,8 @@ TEST(RunContext, SameSeedSameNumbers) {
 
 TEST(RunContext, StageTimerAccumulates) {
   RunContext ctx;
-  {
-    ScopedStageTimer t(ctx, "grasp");
-  }
-  {
-    ScopedStageTimer t(ctx, "grasp");
-  }
+  { ScopedStageTimer t(ctx, "grasp"); }
+  { ScopedStageTimer t(ctx, "grasp"); }
   ASSERT_EQ(ctx.stage_times().count("grasp"), 1u);
   EXPECT_GE(ctx.stage_times().at("grasp"), 0.0);
 }

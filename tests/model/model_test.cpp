@@ -377,8 +377,8 @@ TEST_F(ProjectFixture, MissingMeshNamesFileAndResolvedPath) {
 }
 
 TEST_F(ProjectFixture, PathVariablesUseEnvironmentThenDefault) {
-  doc_["paths"] = {{"LIB",
-                    {{"default", "elsewhere"}, {"env", "WRAP_TEST_LIB_DIR"}, {"hint", "get it"}}}};
+  doc_["paths"] = {
+      {"LIB", {{"default", "elsewhere"}, {"env", "WRAP_TEST_LIB_DIR"}, {"hint", "get it"}}}};
   doc_["parts"][0]["mesh"] = "${LIB}/cube.obj";
   ::unsetenv("WRAP_TEST_LIB_DIR");
   LoadedProject lp = Load();
@@ -426,7 +426,7 @@ TEST_F(ProjectFixture, OpenMeshIsAWarning) {
 }
 
 TEST_F(ProjectFixture, UnitMistakesWarn) {
-  doc_["parts"][0]["scale"] = 1.0;  // 40 m cube: mm read as m
+  doc_["parts"][0]["scale"] = 1.0;   // 40 m cube: mm read as m
   doc_["parts"][1]["scale"] = 1e-6;  // 0.04 mm cube
   const LoadedProject lp = Load();
   ExpectDiag(lp, Severity::kWarning, "parts[0].scale", "larger than 5 m");
@@ -493,8 +493,8 @@ TEST_P(ExampleProject, Validates) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Projects, ExampleProject,
-                         ::testing::Values("stool", "chair", "cross", "cube", "cube_2x2x3",
-                                           "half_stool", "fabrica_beam",
+                         ::testing::Values("stool", "chair", "cross", "cross_openarm", "cube",
+                                           "cube_2x2x3", "half_stool", "fabrica_beam",
                                            "fabrica_plumbers_block", "fabrica_car"));
 
 }  // namespace
