@@ -10,6 +10,8 @@ PACKAGES=(
   libeigen3-dev libassimp-dev nlohmann-json3-dev libcli11-dev
   # robots: collision (FCL + libccd), URDF import
   libfcl-dev libccd-dev liburdfdom-dev
+  # wrench LP: Clp (the reference LP solver behind the dense simplex)
+  coinor-libclp-dev
   # ui: GL, offscreen contexts (EGL, OSMesa), window and widgets
   libgl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libimgui-dev
   # tests and benchmarks

@@ -1,0 +1,441 @@
+// Our dense bounded-variable primal simplex: the fast LP backend of the wrench stage.
+//
+// The LPs of one assembly step are tiny (6 rows per body, a few dozen columns), where the set-up
+// cost of a general sparse solver dominates: Clp needs ~40-120 us where a dense tableau needs a
+// few. The method is the textbook two-phase primal simplex on the full tableau T = B^-1 A:
+//  - every variable starts nonbasic at 0 clipped into its bounds (0 may lie strictly inside the
+//    bounds, e.g. a free variable: such a variable may move either way);
+//  - one artificial per row, signed so that it starts at |residual| >= 0, forms the first basis;
+//    artificials are never stored as columns and, once they leave the basis, never come back;
+//  - phase 1 minimises the sum of artificials; phase 2 keeps the remaining ones fixed at 0;
+//  - pricing: Dantzig (largest reduced cost, lowest index on ties); ratio test: Harris' two
+//    passes with a feasibility tolerance, preferring the largest pivot; after a run of
+//    degenerate pivots Bland's rule takes over until progress resumes, which rules out cycling.
+// LoadBase/SolveWithColumn serve the wrench LP, solved once per vertex of U with only the load
+// column changing and a start without residual (x = 0): the artificials are crashed out of the
+// basis once (Gauss-Jordan, keeping B^-1), and each vertex starts phase 2 from that basis with
+// its column B^-1 w. That skips the ~m degenerate pivots a cold start spends per vertex.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "wrench/lp.h"
+
+namespace wrap {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kPivotTol = 1e-9;  // Tableau entries smaller than this are not pivots.
+constexpr double kOptTol = 1e-9;    // Reduced costs within this of 0 are optimal.
+constexpr double kFeasTol = 1e-9;   // Harris' bound relaxation.
+constexpr int kDegenerateRunForBland = 8;
+
+class DenseSimplex final : public LpBackend {
+ public:
+  std::string_view name() const override { return "dense"; }
+  LpStatus Solve(const LpProblem& problem, LpSolution& solution) override;
+  void LoadBase(const LpProblem& problem, int varying_column) override;
+  LpStatus SolveWithColumn(const double* values, LpSolution& solution) override;
+
+ private:
+  // Sizes, bounds, the starting point and the artificial basis of `problem`; kOptimal when the
+  // problem is well formed (need_phase1: some artificial is not zero).
+  LpStatus Setup(const LpProblem& problem, bool& need_phase1);
+  // Phases 1 (when needed) and 2 from the current basis, then the solution.
+  LpStatus Run(bool need_phase1, const std::vector<double>& cost, LpSolution& solution);
+  // Runs simplex iterations of one phase until optimal, unbounded or the iteration limit.
+  LpStatus Iterate(bool phase1);
+  // Reduced costs of the structural columns for the current basis and phase.
+  void PriceAll(bool phase1, const std::vector<double>& cost);
+  // Pivots the tableau on row p, column q (and the reduced-cost row with it).
+  void Pivot(int p, int q);
+  // Bounds of the basic variable of row r.
+  void HeadBounds(int r, bool phase1, double& lb, double& ub) const {
+    const int h = head_[r];
+    if (h < n_) {
+      lb = lo_[h];
+      ub = up_[h];
+    } else {
+      lb = 0.0;
+      ub = phase1 ? kInf : 0.0;
+    }
+  }
+
+  int m_ = 0;
+  int n_ = 0;
+  int w_ = 0;  // Row stride of the tableau: n rounded up to a multiple of 4 (zero padding).
+  int iterations_ = 0;
+  int max_iterations_ = 0;
+  std::vector<double> t_;    // Tableau B^-1 A, row-major m x w (columns >= n are 0).
+  std::vector<double> xb_;   // Value of the basic variable of each row.
+  std::vector<int> head_;    // Basic variable of each row: j < n structural, n + r artificial.
+  std::vector<int> row_of_;  // Row where structural j is basic, or -1.
+  std::vector<double> x_;    // Values of the nonbasic structurals.
+  std::vector<double> lo_;   // Bounds of the structurals.
+  std::vector<double> up_;
+  std::vector<double> d_;     // Reduced costs of the structurals (w entries, padding 0).
+  std::vector<double> zero_;  // Phase-1 structural costs (all zero).
+  double scale_ = 1.0;        // Largest |rhs|, at least 1: scales the phase-1 tolerance.
+
+  // LoadBase's crash basis, the start of every SolveWithColumn.
+  bool crashed_ = false;
+  std::vector<double> binv_;  // B^-1 of the crash basis, row-major m x m.
+  std::vector<double> t0_;
+  std::vector<int> head0_;
+  std::vector<int> row_of0_;
+  std::vector<double> xb0_;
+  std::vector<double> x0_;
+};
+
+// y -= f * x over w entries, w a multiple of 4: four independent statements per step let the
+// compiler's straight-line vectoriser use SIMD at -O2 (the tableau update is the hot loop).
+inline void Axpy4(double* __restrict y, const double* __restrict x, double f, int w) {
+  for (int j = 0; j < w; j += 4) {
+    y[j] -= f * x[j];
+    y[j + 1] -= f * x[j + 1];
+    y[j + 2] -= f * x[j + 2];
+    y[j + 3] -= f * x[j + 3];
+  }
+}
+
+void DenseSimplex::PriceAll(bool phase1, const std::vector<double>& cost) {
+  // d_j = c_j - sum_r c_head(r) T_rj, where artificials cost 1 in phase 1 and 0 in phase 2.
+  for (int j = 0; j < n_; ++j) d_[j] = cost[j];
+  for (int j = n_; j < w_; ++j) d_[j] = 0.0;
+  for (int r = 0; r < m_; ++r) {
+    const int h = head_[r];
+    const double c = h < n_ ? cost[h] : (phase1 ? 1.0 : 0.0);
+    if (c == 0.0) continue;
+    Axpy4(d_.data(), &t_[static_cast<std::size_t>(r) * w_], c, w_);
+  }
+  for (int r = 0; r < m_; ++r) {
+    if (head_[r] < n_) d_[head_[r]] = 0.0;
+  }
+}
+
+void DenseSimplex::Pivot(int p, int q) {
+  double* tp = &t_[static_cast<std::size_t>(p) * w_];
+  const double inv = 1.0 / tp[q];
+  for (int j = 0; j < w_; ++j) tp[j] *= inv;
+  tp[q] = 1.0;
+  for (int r = 0; r < m_; ++r) {
+    if (r == p) continue;
+    double* tr = &t_[static_cast<std::size_t>(r) * w_];
+    const double f = tr[q];
+    if (f == 0.0) continue;
+    Axpy4(tr, tp, f, w_);
+    tr[q] = 0.0;
+  }
+  const double f = d_[q];
+  if (f != 0.0) Axpy4(d_.data(), tp, f, w_);
+  d_[q] = 0.0;
+}
+
+LpStatus DenseSimplex::Iterate(bool phase1) {
+  int degenerate_run = 0;
+  bool bland = false;
+  for (;;) {
+    if (iterations_ >= max_iterations_) return LpStatus::kIterationLimit;
+
+    // Pricing: the entering column q and its direction (+1 increase, -1 decrease).
+    int q = -1;
+    int dir = 0;
+    double best = 0.0;
+    for (int j = 0; j < n_; ++j) {
+      if (row_of_[j] >= 0) continue;
+      const double dj = d_[j];
+      int dj_dir = 0;
+      if (dj < -kOptTol && x_[j] < up_[j]) {
+        dj_dir = 1;
+      } else if (dj > kOptTol && x_[j] > lo_[j]) {
+        dj_dir = -1;
+      } else {
+        continue;
+      }
+      const double score = std::abs(dj);
+      if (bland) {
+        q = j;
+        dir = dj_dir;
+        break;
+      }
+      if (score > best) {
+        best = score;
+        q = j;
+        dir = dj_dir;
+      }
+    }
+    if (q < 0) return LpStatus::kOptimal;
+
+    // Harris ratio test, pass 1: the largest step with every bound relaxed by kFeasTol.
+    const double own = dir > 0 ? up_[q] - x_[q] : x_[q] - lo_[q];
+    double theta_max = own;
+    for (int r = 0; r < m_; ++r) {
+      const double alpha = dir * t_[static_cast<std::size_t>(r) * w_ + q];
+      if (std::abs(alpha) <= kPivotTol) continue;
+      double lb, ub;
+      HeadBounds(r, phase1, lb, ub);
+      double lim;
+      if (alpha > 0.0) {
+        if (lb == -kInf) continue;
+        lim = (xb_[r] - lb + kFeasTol) / alpha;
+      } else {
+        if (ub == kInf) continue;
+        lim = (ub - xb_[r] + kFeasTol) / -alpha;
+      }
+      if (lim < theta_max) theta_max = lim;
+    }
+    if (theta_max == kInf) return LpStatus::kUnbounded;
+
+    // Pass 2: among the rows that block within theta_max, the largest pivot (Bland: lowest
+    // basic index). A bound flip of the entering variable needs no pivot: take it when it fits.
+    int p = -1;
+    double theta = 0.0;
+    if (own <= theta_max) {
+      theta = own;
+    } else {
+      double best_alpha = 0.0;
+      int best_head = 0;
+      for (int r = 0; r < m_; ++r) {
+        const double alpha = dir * t_[static_cast<std::size_t>(r) * w_ + q];
+        if (std::abs(alpha) <= kPivotTol) continue;
+        double lb, ub;
+        HeadBounds(r, phase1, lb, ub);
+        double lim;
+        if (alpha > 0.0) {
+          if (lb == -kInf) continue;
+          lim = (xb_[r] - lb) / alpha;
+        } else {
+          if (ub == kInf) continue;
+          lim = (ub - xb_[r]) / -alpha;
+        }
+        if (lim > theta_max) continue;
+        const bool better = p < 0 || (bland ? head_[r] < best_head : std::abs(alpha) > best_alpha);
+        if (better) {
+          p = r;
+          best_alpha = std::abs(alpha);
+          best_head = head_[r];
+          theta = lim < 0.0 ? 0.0 : lim;
+        }
+      }
+      if (p < 0) return LpStatus::kIterationLimit;  // Only tiny pivots block: numerical trouble.
+    }
+    ++iterations_;
+
+    // Move along the edge.
+    x_[q] += dir * theta;
+    if (theta != 0.0) {
+      for (int r = 0; r < m_; ++r) xb_[r] -= dir * theta * t_[static_cast<std::size_t>(r) * w_ + q];
+    }
+    if (p < 0) {
+      x_[q] = dir > 0 ? up_[q] : lo_[q];  // Bound flip: q stays nonbasic at its other bound.
+    } else {
+      const int h = head_[p];
+      const double alpha = dir * t_[static_cast<std::size_t>(p) * w_ + q];
+      if (h < n_) {
+        x_[h] = alpha > 0.0 ? lo_[h] : up_[h];
+        row_of_[h] = -1;
+      }
+      head_[p] = q;
+      row_of_[q] = p;
+      xb_[p] = x_[q];
+      Pivot(p, q);
+    }
+
+    if (theta <= 1e-12) {
+      if (++degenerate_run >= kDegenerateRunForBland) bland = true;
+    } else {
+      degenerate_run = 0;
+      bland = false;
+    }
+  }
+}
+
+LpStatus DenseSimplex::Setup(const LpProblem& problem, bool& need_phase1) {
+  m_ = problem.rows;
+  n_ = problem.cols;
+  if (m_ < 0 || n_ < 0 || problem.a.size() != static_cast<std::size_t>(m_) * n_ ||
+      problem.rhs.size() != static_cast<std::size_t>(m_) ||
+      problem.cost.size() != static_cast<std::size_t>(n_) ||
+      problem.lower.size() != static_cast<std::size_t>(n_) ||
+      problem.upper.size() != static_cast<std::size_t>(n_)) {
+    return LpStatus::kError;
+  }
+  for (int j = 0; j < n_; ++j) {
+    if (!(problem.lower[j] <= problem.upper[j]) || problem.lower[j] == kInf ||
+        problem.upper[j] == -kInf) {
+      return LpStatus::kInfeasible;
+    }
+  }
+  iterations_ = 0;
+  max_iterations_ = 50 * (m_ + n_) + 100;
+  lo_ = problem.lower;
+  up_ = problem.upper;
+  w_ = (n_ + 3) & ~3;
+  x_.resize(n_);
+  d_.resize(w_);
+  row_of_.assign(n_, -1);
+  head_.resize(m_);
+  xb_.resize(m_);
+  t_.assign(static_cast<std::size_t>(m_) * w_, 0.0);
+
+  // Start: each variable at 0 clipped into its bounds; residuals carried by artificials.
+  for (int j = 0; j < n_; ++j) x_[j] = lo_[j] > 0.0 ? lo_[j] : (up_[j] < 0.0 ? up_[j] : 0.0);
+  scale_ = 1.0;
+  need_phase1 = false;
+  for (int r = 0; r < m_; ++r) {
+    double res = problem.rhs[r];
+    for (int j = 0; j < n_; ++j) {
+      if (x_[j] != 0.0) res -= problem.a[static_cast<std::size_t>(j) * m_ + r] * x_[j];
+    }
+    const double sign = res < 0.0 ? -1.0 : 1.0;
+    double* tr = &t_[static_cast<std::size_t>(r) * w_];
+    for (int j = 0; j < n_; ++j) tr[j] = sign * problem.a[static_cast<std::size_t>(j) * m_ + r];
+    head_[r] = n_ + r;
+    xb_[r] = std::abs(res);
+    scale_ = std::max(scale_, std::abs(problem.rhs[r]));
+    if (xb_[r] > 0.0) need_phase1 = true;
+  }
+  return LpStatus::kOptimal;
+}
+
+LpStatus DenseSimplex::Run(bool need_phase1, const std::vector<double>& cost,
+                           LpSolution& solution) {
+  solution.x.assign(n_, 0.0);
+  solution.objective = 0.0;
+  if (need_phase1) {
+    zero_.assign(n_, 0.0);
+    PriceAll(true, zero_);
+    const LpStatus status = Iterate(true);
+    if (status != LpStatus::kOptimal) {
+      solution.iterations = iterations_;
+      return solution.status = status;
+    }
+    double infeasibility = 0.0;
+    for (int r = 0; r < m_; ++r) {
+      if (head_[r] >= n_) infeasibility += xb_[r];
+    }
+    if (infeasibility > 1e-8 * scale_) {
+      solution.iterations = iterations_;
+      return solution.status = LpStatus::kInfeasible;
+    }
+  }
+  PriceAll(false, cost);
+  const LpStatus status = Iterate(false);
+  solution.iterations = iterations_;
+  if (status != LpStatus::kOptimal) return solution.status = status;
+
+  for (int j = 0; j < n_; ++j) solution.x[j] = x_[j];
+  for (int r = 0; r < m_; ++r) {
+    const int h = head_[r];
+    if (h >= n_) continue;
+    // Harris lets basic values stray by up to kFeasTol: put them back inside their bounds.
+    solution.x[h] = std::min(std::max(xb_[r], lo_[h]), up_[h]);
+  }
+  double objective = 0.0;
+  for (int j = 0; j < n_; ++j) objective += cost[j] * solution.x[j];
+  solution.objective = objective;
+  return solution.status = LpStatus::kOptimal;
+}
+
+LpStatus DenseSimplex::Solve(const LpProblem& problem, LpSolution& solution) {
+  bool need_phase1 = false;
+  const LpStatus status = Setup(problem, need_phase1);
+  if (status != LpStatus::kOptimal) {
+    solution.x.assign(std::max(problem.cols, 0), 0.0);
+    solution.objective = 0.0;
+    solution.iterations = 0;
+    return solution.status = status;
+  }
+  return Run(need_phase1, problem.cost, solution);
+}
+
+void DenseSimplex::LoadBase(const LpProblem& problem, int varying_column) {
+  LpBackend::LoadBase(problem, varying_column);
+  crashed_ = false;
+  bool need_phase1 = true;
+  if (varying_column < 0 || varying_column >= problem.cols) return;
+  if (Setup(problem, need_phase1) != LpStatus::kOptimal) return;
+  // The crash needs a start without residual whatever the varying column holds: it must start
+  // at 0 and the other variables' start must satisfy A x = rhs.
+  if (need_phase1 || x_[varying_column] != 0.0) return;
+
+  // Crash: replace artificials by structural columns, widest bounds first (free, one-sided,
+  // boxed; never fixed ones nor the varying column), each on the artificial row where it has the
+  // largest entry. With no residual these pivots move nothing, so the basis stays feasible.
+  // B^-1 is kept beside the tableau for the varying column.
+  binv_.assign(static_cast<std::size_t>(m_) * m_, 0.0);
+  for (int r = 0; r < m_; ++r) binv_[static_cast<std::size_t>(r) * m_ + r] = 1.0;
+  for (int pass = 0; pass < 3; ++pass) {
+    for (int j = 0; j < n_; ++j) {
+      if (j == varying_column || lo_[j] == up_[j] || row_of_[j] >= 0) continue;
+      const int finite = (std::isfinite(lo_[j]) ? 1 : 0) + (std::isfinite(up_[j]) ? 1 : 0);
+      if (finite != pass) continue;
+      int p = -1;
+      double best = 1e-6;
+      double column_max = 0.0;
+      for (int r = 0; r < m_; ++r) {
+        column_max = std::max(column_max, std::abs(t_[static_cast<std::size_t>(r) * w_ + j]));
+      }
+      for (int r = 0; r < m_; ++r) {
+        const double v = std::abs(t_[static_cast<std::size_t>(r) * w_ + j]);
+        if (head_[r] >= n_ && v > best && v >= 0.1 * column_max) {
+          best = v;
+          p = r;
+        }
+      }
+      if (p < 0) continue;
+      // Gauss-Jordan on (T | B^-1) at (p, j); the reduced costs are set per solve.
+      const double inv = 1.0 / t_[static_cast<std::size_t>(p) * w_ + j];
+      double* tp = &t_[static_cast<std::size_t>(p) * w_];
+      double* bp = &binv_[static_cast<std::size_t>(p) * m_];
+      for (int k = 0; k < w_; ++k) tp[k] *= inv;
+      for (int k = 0; k < m_; ++k) bp[k] *= inv;
+      tp[j] = 1.0;
+      for (int r = 0; r < m_; ++r) {
+        if (r == p) continue;
+        const double f = t_[static_cast<std::size_t>(r) * w_ + j];
+        if (f == 0.0) continue;
+        Axpy4(&t_[static_cast<std::size_t>(r) * w_], tp, f, w_);
+        double* br = &binv_[static_cast<std::size_t>(r) * m_];
+        for (int k = 0; k < m_; ++k) br[k] -= f * bp[k];
+        t_[static_cast<std::size_t>(r) * w_ + j] = 0.0;
+      }
+      xb_[p] = x_[j];
+      head_[p] = j;
+      row_of_[j] = p;
+    }
+  }
+  t0_ = t_;
+  head0_ = head_;
+  row_of0_ = row_of_;
+  xb0_ = xb_;
+  x0_ = x_;
+  crashed_ = true;
+}
+
+LpStatus DenseSimplex::SolveWithColumn(const double* values, LpSolution& solution) {
+  if (!crashed_) return LpBackend::SolveWithColumn(values, solution);
+  t_ = t0_;
+  head_ = head0_;
+  row_of_ = row_of0_;
+  xb_ = xb0_;
+  x_ = x0_;
+  iterations_ = 0;
+  // The varying column in the crash basis: B^-1 values.
+  const int q = varying_column_;
+  for (int r = 0; r < m_; ++r) {
+    const double* br = &binv_[static_cast<std::size_t>(r) * m_];
+    double v = 0.0;
+    for (int k = 0; k < m_; ++k) v += br[k] * values[k];
+    t_[static_cast<std::size_t>(r) * w_ + q] = v;
+  }
+  return Run(false, base_.cost, solution);
+}
+
+}  // namespace
+
+std::unique_ptr<LpBackend> MakeDenseSimplexBackend() { return std::make_unique<DenseSimplex>(); }
+
+}  // namespace wrap
