@@ -1,6 +1,7 @@
 #include "cli.h"
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <ostream>
 
 namespace wrap::cli {
@@ -30,6 +31,20 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       "info", "Describe a project: parts, the assembly DAG, robots and end effectors");
   info->add_option("PROJECT", project, "Project file (.json)")->required();
 
+  PreprocessArgs pre;
+  std::uint64_t seed = 0;
+  CLI::App* preprocess = app.add_subcommand(
+      "preprocess", "Subassemblies, stable placements, table slots and grasp sets (paper IV-B)");
+  preprocess->add_option("PROJECT", pre.project, "Project file (.json)")->required();
+  preprocess->add_option("-o,--output", pre.output, "Write the result as JSON to this file");
+  preprocess->add_option("--grasps", pre.grasps, "Grasp-set size (default: the project's)")
+      ->check(CLI::PositiveNumber);
+  preprocess->add_option("--slots", pre.slots, "Number of table slots")
+      ->check(CLI::NonNegativeNumber);
+  CLI::Option* seed_option =
+      preprocess->add_option("--seed", seed, "Random seed (default: the project's)");
+
+
   // CLI11 takes arguments in reverse order.
   std::vector<std::string> reversed(args.rbegin(), args.rend());
   try {
@@ -41,6 +56,10 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   }
   if (validate->parsed()) return Validate(project, quiet, out, err);
   if (info->parsed()) return Info(project, out, err);
+  if (preprocess->parsed()) {
+    if (seed_option->count() > 0) pre.seed = seed;
+    return Preprocess(pre, out, err);
+  }
   // No subcommand: the GUI will open here once it exists; until then explain what there is.
   out << app.help();
   return 0;

@@ -8,11 +8,16 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   # engine: math, mesh import, project files, command line
   libeigen3-dev libassimp-dev nlohmann-json3-dev libcli11-dev
+  # preprocessing: convex hulls (qhull), parallel grasp sampling (oneTBB)
+  libqhull-dev libtbb-dev
   # robots: collision (FCL + libccd), URDF import
   libfcl-dev libccd-dev liburdfdom-dev
   # wrench LP: Clp (the reference LP solver behind the dense simplex)
   coinor-libclp-dev
-  # ui: GL, offscreen contexts (EGL, OSMesa), window and widgets
+  # sim: MuJoCo (its CMake config also wants libgl-dev and libqhull-dev)
+  libmujoco-dev libqhull-dev
+  # ui: GL, offscreen contexts (EGL, OSMesa), PNG (stb), window and widgets
+  libstb-dev
   libgl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libimgui-dev
   # tests and benchmarks
   libgtest-dev libbenchmark-dev

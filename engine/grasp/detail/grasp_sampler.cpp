@@ -1,0 +1,266 @@
+#include "grasp/detail/grasp_sampler.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace wrap::detail {
+
+namespace {
+
+constexpr int kStopCheckEvery = 16;  // samples between ShouldStop() checks (~1 ms)
+constexpr double kSelfHit = 1e-6;    // rays ignore hits nearer than this [m]
+constexpr int kMaxApproaches = 64;   // approach directions per contact pair, at most
+
+// A unit vector at angle `angle` from `axis`, rotated by `phase` about it.
+Vec3 Tilted(const Vec3& axis, double angle, double phase) {
+  const Vec3 u = axis.unitOrthogonal();
+  const Vec3 v = axis.cross(u);
+  return std::cos(angle) * axis + std::sin(angle) * (std::cos(phase) * u + std::sin(phase) * v);
+}
+
+double AngleBetween(const Vec3& a, const Vec3& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+// How much of a finger pad touches the part: rays across the pad rectangle (centre `c`, width
+// axis e_w, length axis e_l) toward the part along `in`. The pad settles on the most protruding
+// point; points within `tol` of it touch. Returns the touching area [m^2], or -1 when the pad
+// cannot reach the contact: something protrudes more than `tol` in front of it, or the ray
+// starts inside material. Returns 0 early once fewer than `min_hits` rays can touch.
+double PadContact(const MeshRaycaster& part, const Vec3& c, const Vec3& in, const Vec3& e_w,
+                  const Vec3& e_l, double width, double length, double tol, double back, int rays_w,
+                  int rays_l, int min_hits) {
+  double s_min = std::numeric_limits<double>::infinity();
+  double s[64];
+  int n = 0, hits = 0, misses = 0;
+  const int total = rays_w * rays_l;
+  for (int i = 0; i < rays_w; ++i) {
+    for (int j = 0; j < rays_l; ++j) {
+      const Vec3 g = c + e_w * (width * ((i + 0.5) / rays_w - 0.5)) +
+                     e_l * (length * ((j + 0.5) / rays_l - 0.5));
+      const auto hit = part.Cast(g - back * in, in, 0.0, back + tol);
+      double depth = std::numeric_limits<double>::infinity();
+      if (hit) {
+        if (part.normal(hit->triangle).dot(in) > 0.0) return -1.0;  // started inside material
+        depth = hit->t - back;
+        if (depth < -tol) return -1.0;
+        s_min = std::min(s_min, depth);
+        ++hits;
+      } else if (++misses > total - min_hits) {
+        return 0.0;
+      }
+      if (n < 64) s[n++] = depth;
+    }
+  }
+  if (hits == 0) return 0.0;
+  int touching = 0;
+  for (int k = 0; k < n; ++k) touching += s[k] <= s_min + tol ? 1 : 0;
+  return width * length * touching / (rays_w * rays_l);
+}
+
+// The rotation whose columns are the images of the TCP axes (closing c_T, approach a_T) in P.
+Mat3 FrameFromAxes(const Vec3& c_P, const Vec3& a_P, const Vec3& c_T, const Vec3& a_T) {
+  Mat3 P, T;
+  P << c_P, a_P, c_P.cross(a_P);
+  T << c_T, a_T, c_T.cross(a_T);
+  return P * T.transpose();
+}
+
+}  // namespace
+
+std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
+                                            const TwoFingerGraspOptions& options,
+                                            GripperCollision& world, std::mt19937_64& rng,
+                                            const RunContext& ctx) {
+  std::vector<GraspCandidate> out;
+  const EndEffector& ee = *in.ee;
+  const MeshRaycaster& part = *in.part;
+  if (ee.stroke_m <= 0.0 || part.area() <= 0.0) return out;
+  const double alpha = std::atan(in.friction);
+  const double max_width = ee.stroke_m - 2.0 * options.clearance_m;
+  // TCP-frame axes: closing (catalog, in F) and approach (F's z), orthonormalised.
+  const Mat3 R_TF = ee.X_FT.linear().transpose();
+  const Vec3 a_T = (R_TF * Vec3::UnitZ()).normalized();
+  Vec3 c_T = R_TF * ee.fingers.closing_axis_F;
+  c_T = (c_T - c_T.dot(a_T) * a_T).normalized();
+  const Vec3 pad_T = ee.X_FT.inverse() * ee.pad_center_F;
+  const double pad_area = ee.pad_width_m * ee.pad_length_m;
+  const double back = options.clearance_m + options.contact_tolerance_m + 2e-3;
+  const int rays_w = std::clamp(options.pad_rays_width, 1, 8);
+  const int rays_l = std::clamp(options.pad_rays_length, 1, 8);
+  // Each touching ray stands for 1 / (rays_w rays_l) of the pad.
+  const int min_hits = pad_area > 0.0
+                           ? static_cast<int>(std::ceil(
+                                 options.min_pad_contact_m2 / pad_area * rays_w * rays_l - 1e-9))
+                           : 1;
+
+  for (int sample = 0; sample < in.max_samples && static_cast<int>(out.size()) < in.wanted;
+       ++sample) {
+    if (sample % kStopCheckEvery == 0 && ctx.ShouldStop()) break;
+    int tri = -1;
+    const Vec3 p = part.SamplePoint(rng, &tri);
+    const Vec3& n_p = part.normal(tri);
+    // Closing direction from p into the part, inside half the friction cone about -n_p.
+    const Vec3 d =
+        Tilted(-n_p, 0.5 * alpha * Uniform01(rng), 2.0 * std::numbers::pi * Uniform01(rng));
+    const auto hit = part.Cast(p, d, kSelfHit, max_width + kSelfHit);
+    if (!hit) continue;
+    const Vec3& n_q = part.normal(hit->triangle);
+    if (n_q.dot(d) <= 0.0) continue;  // entered material: not an exit point (broken mesh)
+    const double width = hit->t;
+    if (width < options.min_width_m || width > max_width) continue;
+    const double angle_p = AngleBetween(d, -n_p);
+    const double angle_q = AngleBetween(d, n_q);
+    if (angle_p > alpha || angle_q > alpha) continue;
+    const Vec3 q = p + width * d;
+    const Vec3 m = 0.5 * (p + q);
+
+    const double phase0 = 2.0 * std::numbers::pi * Uniform01(rng);
+    const int approaches = std::clamp(options.approach_samples, 1, kMaxApproaches);
+    // A pad rectangle is symmetric under a half turn: approaches pi apart share pad tests.
+    const int period = approaches % 2 == 0 ? approaches / 2 : approaches;
+    std::array<double, kMaxApproaches> pad_p, pad_q;
+    pad_p.fill(std::numeric_limits<double>::quiet_NaN());
+    pad_q.fill(std::numeric_limits<double>::quiet_NaN());
+    for (int k = 0; k < approaches; ++k) {
+      const Vec3 a =
+          Tilted(d, 0.5 * std::numbers::pi, phase0 + 2.0 * std::numbers::pi * k / approaches);
+      const Vec3 e_w = d.cross(a);
+      // Pads: the one at -d pushes p along +d, the one at +d pushes q along -d.
+      const int key = k % period;
+      if (std::isnan(pad_p[key])) {
+        pad_p[key] = PadContact(part, p, d, e_w, a, ee.pad_width_m, ee.pad_length_m,
+                                options.contact_tolerance_m, back, rays_w, rays_l, min_hits);
+      }
+      const double area_p = pad_p[key];
+      if (area_p < options.min_pad_contact_m2) continue;
+      if (std::isnan(pad_q[key])) {
+        pad_q[key] = PadContact(part, q, -d, e_w, a, ee.pad_width_m, ee.pad_length_m,
+                                options.contact_tolerance_m, back, rays_w, rays_l, min_hits);
+      }
+      const double area_q = pad_q[key];
+      if (area_q < options.min_pad_contact_m2) continue;
+      Iso3 X_PG = Iso3::Identity();
+      X_PG.linear() = FrameFromAxes(d, a, c_T, a_T);
+      X_PG.translation() = m - X_PG.linear() * pad_T;
+      if (world.Collides(in.ee_index, in.X_AP * X_PG, width + 2.0 * options.clearance_m)) {
+        continue;
+      }
+      GraspCandidate c;
+      c.grasp.part = in.part_index;
+      c.grasp.end_effector = ee.name;
+      c.grasp.kind = ee.kind;
+      c.grasp.X_PG = X_PG;
+      c.grasp.width_m = width;
+      c.grasp.contacts_P = {q, p};  // the finger on G's +x (+d) side touches q
+      c.grasp.contact_area_m2 = std::min(area_p, area_q);
+      c.center_P = m;
+      c.axis_P = d;
+      c.approach_P = a;
+      c.slack = alpha > 0.0 ? 1.0 - std::max(angle_p, angle_q) / alpha : 0.0;
+      c.pad_fraction = pad_area > 0.0 ? std::min(1.0, c.grasp.contact_area_m2 / pad_area) : 0.0;
+      out.push_back(std::move(c));
+      break;  // one grasp per contact pair keeps the candidates spread
+    }
+  }
+  return out;
+}
+
+std::vector<GraspCandidate> SampleVacuum(const SamplerInput& in, const VacuumGraspOptions& options,
+                                         GripperCollision& world, std::mt19937_64& rng,
+                                         const RunContext& ctx) {
+  std::vector<GraspCandidate> out;
+  const EndEffector& ee = *in.ee;
+  const MeshRaycaster& part = *in.part;
+  const double radius = 0.5 * ee.cup_diameter_m;
+  if (radius <= 0.0 || part.area() <= 0.0) return out;
+  const double tol = options.flatness_tolerance_m;
+  const double cos_dev = std::cos(options.max_normal_deviation_rad);
+  const double back = tol + 2e-3;
+  const int inner = std::clamp(options.inner_ring_points, 0, 64);
+  const int rim = std::clamp(options.rim_points, 3, 128);
+  const int total = 1 + inner + rim;
+  const int needed = static_cast<int>(std::ceil(options.min_support_fraction * total - 1e-9));
+  // TCP axes: z into the part along the cup axis; x is free (the cup is round).
+  const Mat3 R_TF = ee.X_FT.linear().transpose();
+  const Vec3 a_T = (R_TF * Vec3::UnitZ()).normalized();
+  const Vec3 x_T = a_T.unitOrthogonal();
+
+  for (int sample = 0; sample < in.max_samples && static_cast<int>(out.size()) < in.wanted;
+       ++sample) {
+    if (sample % kStopCheckEvery == 0 && ctx.ShouldStop()) break;
+    int tri = -1;
+    const Vec3 p = part.SamplePoint(rng, &tri);
+    const Vec3 n = part.normal(tri);
+    const Vec3 u = Tilted(n, 0.5 * std::numbers::pi, 2.0 * std::numbers::pi * Uniform01(rng));
+    const Vec3 v = n.cross(u);
+    // Disc test points: the centre, a ring at r/2 and the rim.
+    int supported = 0;
+    double worst = 0.0;  // largest deviation as a fraction of what is allowed
+    bool blocked = false;
+    for (int k = 0; k < total && !blocked; ++k) {
+      Vec3 offset = Vec3::Zero();
+      if (k > 0) {
+        const bool on_rim = k > inner;
+        const int idx = on_rim ? k - 1 - inner : k - 1;
+        const int count = on_rim ? rim : inner;
+        // The rim points lie on a polygon circumscribing the cup: all of it supported on a
+        // flat face means the whole disc is.
+        const double r = on_rim ? radius / std::cos(std::numbers::pi / count) : 0.5 * radius;
+        const double phi = 2.0 * std::numbers::pi * (idx + (on_rim ? 0.0 : 0.5)) / count;
+        offset = r * (std::cos(phi) * u + std::sin(phi) * v);
+      }
+      const auto hit = part.Cast(p + offset + back * n, -n, 0.0, back + tol);
+      if (!hit) continue;
+      const Vec3& n_hit = part.normal(hit->triangle);
+      const double depth = hit->t - back;
+      // Material in front of the tangent plane: the cup would sit on it, not on the patch.
+      if (n_hit.dot(n) < 0.0 || depth < -tol) {
+        blocked = true;
+        break;
+      }
+      const double cos_hit = n_hit.dot(n);
+      if (cos_hit < cos_dev) continue;
+      ++supported;
+      const double angle = std::acos(std::clamp(cos_hit, -1.0, 1.0));
+      worst = std::max({worst, std::abs(depth) / tol,
+                        options.max_normal_deviation_rad > 0.0
+                            ? angle / options.max_normal_deviation_rad
+                            : 0.0});
+    }
+    if (blocked || supported < needed || supported < 1) continue;
+
+    const double yaw0 = 2.0 * std::numbers::pi * Uniform01(rng);
+    const int yaws = std::max(1, options.yaw_samples);
+    for (int k = 0; k < yaws; ++k) {
+      // The gripper body is square: a quarter turn covers every distinct yaw.
+      const double yaw = yaw0 + 0.5 * std::numbers::pi * k / yaws;
+      const Vec3 x_P = std::cos(yaw) * u + std::sin(yaw) * v;
+      Iso3 X_PG = Iso3::Identity();
+      X_PG.linear() = FrameFromAxes(x_P, -n, x_T, a_T);
+      X_PG.translation() = p;
+      Iso3 X_PG_backed = X_PG;
+      X_PG_backed.translation() += options.standoff_m * n;
+      if (world.Collides(in.ee_index, in.X_AP * X_PG_backed, 0.0)) continue;
+      GraspCandidate c;
+      c.grasp.part = in.part_index;
+      c.grasp.end_effector = ee.name;
+      c.grasp.kind = ee.kind;
+      c.grasp.X_PG = X_PG;
+      c.grasp.contacts_P = {p, p};
+      c.grasp.contact_area_m2 = std::numbers::pi * radius * radius;
+      c.center_P = p;
+      c.axis_P = -n;
+      c.approach_P = -n;
+      c.slack = std::clamp(1.0 - worst, 0.0, 1.0);
+      out.push_back(std::move(c));
+      break;
+    }
+  }
+  return out;
+}
+
+}  // namespace wrap::detail

@@ -1,0 +1,56 @@
+// The two grasp samplers on one part (paper §IV-B): antipodal two-finger grasps and vacuum
+// grasps, each checked against the part itself. Subassemblies filter and select from them.
+#pragma once
+
+#include <random>
+#include <vector>
+
+#include "core/run_context.h"
+#include "grasp/detail/gripper_collision.h"
+#include "grasp/detail/mesh_raycaster.h"
+#include "grasp/grasp.h"
+#include "robot/catalog.h"
+
+namespace wrap::detail {
+
+/// A grasp found on a part, before a subassembly scores and selects it.
+struct GraspCandidate {
+  Grasp grasp;                      ///< part, end effector, X_PG, width, contacts, area.
+  Vec3 center_P = Vec3::Zero();     ///< Contact midpoint (two-finger) or cup centre, in P [m].
+  Vec3 axis_P = Vec3::UnitX();      ///< Closing line (two-finger) or cup axis, unit, in P.
+  Vec3 approach_P = Vec3::UnitZ();  ///< Approach direction of the gripper (G's z), in P.
+  double slack = 0.0;         ///< Friction-cone (two-finger) or flatness (vacuum) slack in [0, 1].
+  double pad_fraction = 0.0;  ///< Two-finger: smaller pad contact / pad area, in [0, 1].
+};
+
+/// What one sampling run needs: the part (its raycaster and index into the collision world),
+/// where it sits in A, and the end effector.
+struct SamplerInput {
+  const MeshRaycaster* part = nullptr;  ///< The part's surface, in P.
+  int part_index = -1;                  ///< Index into Project::parts (and the world's parts).
+  Iso3 X_AP = Iso3::Identity();         ///< Its assembled pose.
+  const EndEffector* ee = nullptr;      ///< The end effector.
+  int ee_index = 0;                     ///< Its index in the collision world.
+  double friction = 0.5;                ///< Pad friction coefficient (two-finger).
+  int wanted = 0;                       ///< Stop after this many candidates.
+  int max_samples = 0;                  ///< ... or after this many surface samples.
+};
+
+/// Antipodal sampling: a surface point, a closing line inside its friction cone, the exit point
+/// of that line within the stroke and inside its friction cone, pads touching both sides over the
+/// minimum area, and an approach direction about the line for which the open gripper does not
+/// touch the part (`world` must have exactly this part enabled). Stops early when ctx says so.
+std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
+                                            const TwoFingerGraspOptions& options,
+                                            GripperCollision& world, std::mt19937_64& rng,
+                                            const RunContext& ctx);
+
+/// Vacuum sampling: a surface point whose cup disc rests on a flat patch (every test point of
+/// the disc on the tangent plane within the tolerance, normals aligned), cup axis along the
+/// normal, and a rotation about it for which the gripper, backed off by the standoff, does not
+/// touch the part.
+std::vector<GraspCandidate> SampleVacuum(const SamplerInput& in, const VacuumGraspOptions& options,
+                                         GripperCollision& world, std::mt19937_64& rng,
+                                         const RunContext& ctx);
+
+}  // namespace wrap::detail

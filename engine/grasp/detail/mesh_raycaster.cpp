@@ -1,0 +1,246 @@
+#include "grasp/detail/mesh_raycaster.h"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <numeric>
+
+namespace wrap::detail {
+
+namespace {
+
+constexpr int kLeafSize = 4;
+constexpr int kSahDepth = 48;   // deeper nodes split at the median
+constexpr int kMaxDepth = 128;  // kSahDepth + log2(2^31 triangles) + slack: the traversal stack
+
+// Slab test: the entry distance of the ray into the box if it enters within (t_min, t_max).
+bool RayBox(const Vec3& o, const Vec3& inv_d, const Vec3& lo, const Vec3& hi, double t_min,
+            double t_max, double* t_enter) {
+  double t0 = t_min, t1 = t_max;
+  for (int a = 0; a < 3; ++a) {
+    double ta = (lo[a] - o[a]) * inv_d[a];
+    double tb = (hi[a] - o[a]) * inv_d[a];
+    if (ta > tb) std::swap(ta, tb);
+    // NaN (0 * inf on a slab boundary) compares false and leaves the bound alone.
+    if (ta > t0) t0 = ta;
+    if (tb < t1) t1 = tb;
+    if (t0 > t1) return false;
+  }
+  *t_enter = t0;
+  return true;
+}
+
+// Moller-Trumbore, both sides: the distance to the triangle's plane crossing or -1.
+double RayTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e1 = b - a, e2 = c - a;
+  const Vec3 p = d.cross(e2);
+  const double det = e1.dot(p);
+  if (std::abs(det) < 1e-300) return -1.0;
+  const double inv = 1.0 / det;
+  const Vec3 s = o - a;
+  const double u = s.dot(p) * inv;
+  if (u < 0.0 || u > 1.0) return -1.0;
+  const Vec3 q = s.cross(e1);
+  const double v = d.dot(q) * inv;
+  if (v < 0.0 || u + v > 1.0) return -1.0;
+  return e2.dot(q) * inv;
+}
+
+}  // namespace
+
+MeshRaycaster::MeshRaycaster(const TriangleMesh& mesh) : mesh_(mesh) {
+  const int n = static_cast<int>(mesh_.triangles.size());
+  normals_.resize(n);
+  cumulative_area_.resize(n);
+  std::vector<Vec3> centroids(n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3i& t = mesh_.triangles[i];
+    const Vec3& a = mesh_.vertices[t[0]];
+    const Vec3& b = mesh_.vertices[t[1]];
+    const Vec3& c = mesh_.vertices[t[2]];
+    const Vec3 cr = (b - a).cross(c - a);
+    const double area = 0.5 * cr.norm();
+    normals_[i] = area > 0.0 ? Vec3(cr.normalized()) : Vec3::Zero();
+    total_area_ += area;
+    cumulative_area_[i] = total_area_;
+    centroids[i] = (a + b + c) / 3.0;
+  }
+  order_.resize(n);
+  std::iota(order_.begin(), order_.end(), 0);
+  nodes_.reserve(2 * n / kLeafSize + 2);
+  nodes_.emplace_back();
+  if (n > 0) Build(0, n, centroids);
+}
+
+void MeshRaycaster::Build(int begin, int end, std::vector<Vec3>& centroids) {
+  // Iterative over an explicit stack: node 0 is the root and already allocated.
+  struct Task {
+    int node, begin, end, depth;
+  };
+  std::vector<Task> stack = {{0, begin, end, 0}};
+  while (!stack.empty()) {
+    const Task task = stack.back();
+    stack.pop_back();
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 hi = -lo;
+    Vec3 clo = lo, chi = hi;
+    for (int k = task.begin; k < task.end; ++k) {
+      const Eigen::Vector3i& t = mesh_.triangles[order_[k]];
+      for (int c = 0; c < 3; ++c) {
+        lo = lo.cwiseMin(mesh_.vertices[t[c]]);
+        hi = hi.cwiseMax(mesh_.vertices[t[c]]);
+      }
+      clo = clo.cwiseMin(centroids[order_[k]]);
+      chi = chi.cwiseMax(centroids[order_[k]]);
+    }
+    Node& node = nodes_[task.node];
+    node.lo = lo;
+    node.hi = hi;
+    const int count = task.end - task.begin;
+    int axis = 0;
+    (chi - clo).maxCoeff(&axis);
+    if (count <= kLeafSize || chi[axis] - clo[axis] <= 0.0) {
+      node.left = task.begin;
+      node.count = count;
+      continue;
+    }
+    // Binned surface-area heuristic along the longest centroid axis: CAD meshes are full of
+    // long slivers, for which median splits give boxes that overlap a lot.
+    constexpr int kBins = 16;
+    struct Bin {
+      Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+      Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+      int count = 0;
+    };
+    std::array<Bin, kBins> bins;
+    const double scale = kBins / (chi[axis] - clo[axis]);
+    auto bin_of = [&](int tri) {
+      return std::min(kBins - 1, static_cast<int>((centroids[tri][axis] - clo[axis]) * scale));
+    };
+    for (int k = task.begin; k < task.end; ++k) {
+      Bin& b = bins[bin_of(order_[k])];
+      const Eigen::Vector3i& t = mesh_.triangles[order_[k]];
+      for (int c = 0; c < 3; ++c) {
+        b.lo = b.lo.cwiseMin(mesh_.vertices[t[c]]);
+        b.hi = b.hi.cwiseMax(mesh_.vertices[t[c]]);
+      }
+      ++b.count;
+    }
+    auto half_area = [](const Vec3& box_lo, const Vec3& box_hi) {
+      if (box_lo.x() > box_hi.x()) return 0.0;
+      const Vec3 e = box_hi - box_lo;
+      return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+    };
+    std::array<double, kBins> right_cost{};
+    Bin acc;
+    for (int b = kBins - 1; b > 0; --b) {
+      acc.lo = acc.lo.cwiseMin(bins[b].lo);
+      acc.hi = acc.hi.cwiseMax(bins[b].hi);
+      acc.count += bins[b].count;
+      right_cost[b] = half_area(acc.lo, acc.hi) * acc.count;
+    }
+    int best_split = -1;
+    double best_cost = std::numeric_limits<double>::infinity();
+    acc = Bin();
+    for (int b = 0; b < kBins - 1; ++b) {
+      acc.lo = acc.lo.cwiseMin(bins[b].lo);
+      acc.hi = acc.hi.cwiseMax(bins[b].hi);
+      acc.count += bins[b].count;
+      if (acc.count == 0 || acc.count == count) continue;
+      const double cost = half_area(acc.lo, acc.hi) * acc.count + right_cost[b + 1];
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_split = b;
+      }
+    }
+    int mid = task.begin + count / 2;
+    // Past kSahDepth levels only median splits: the depth stays below kMaxDepth for any mesh.
+    if (best_split >= 0 && task.depth < kSahDepth) {
+      mid = static_cast<int>(
+          std::stable_partition(order_.begin() + task.begin, order_.begin() + task.end,
+                                [&](int tri) { return bin_of(tri) <= best_split; }) -
+          order_.begin());
+    }
+    if (mid == task.begin || mid == task.end) {
+      mid = task.begin + count / 2;
+      std::nth_element(order_.begin() + task.begin, order_.begin() + mid, order_.begin() + task.end,
+                       [&](int a, int b) {
+                         return centroids[a][axis] < centroids[b][axis] ||
+                                (centroids[a][axis] == centroids[b][axis] && a < b);
+                       });
+    }
+    const int left = static_cast<int>(nodes_.size());
+    nodes_[task.node].left = left;
+    nodes_[task.node].count = 0;
+    nodes_.emplace_back();
+    nodes_.emplace_back();
+    stack.push_back({left + 1, mid, task.end, task.depth + 1});
+    stack.push_back({left, task.begin, mid, task.depth + 1});
+  }
+}
+
+std::optional<RayHit> MeshRaycaster::Cast(const Vec3& origin, const Vec3& dir, double t_min,
+                                          double t_max) const {
+  if (mesh_.triangles.empty()) return std::nullopt;
+  const Vec3 inv_d(1.0 / dir.x(), 1.0 / dir.y(), 1.0 / dir.z());
+  RayHit best;
+  double best_t = t_max;
+  std::array<int, kMaxDepth + 2> stack;
+  int top = 0;
+  double t_enter = 0.0;
+  if (!RayBox(origin, inv_d, nodes_[0].lo, nodes_[0].hi, t_min, best_t, &t_enter)) {
+    return std::nullopt;
+  }
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (node.count > 0) {
+      for (int k = node.left; k < node.left + node.count; ++k) {
+        const Eigen::Vector3i& t = mesh_.triangles[order_[k]];
+        const double h = RayTriangle(origin, dir, mesh_.vertices[t[0]], mesh_.vertices[t[1]],
+                                     mesh_.vertices[t[2]]);
+        if (h > t_min && h < best_t) {
+          best_t = h;
+          best.t = h;
+          best.triangle = order_[k];
+        }
+      }
+      continue;
+    }
+    double ta = 0.0, tb = 0.0;
+    const bool hit_a =
+        RayBox(origin, inv_d, nodes_[node.left].lo, nodes_[node.left].hi, t_min, best_t, &ta);
+    const bool hit_b = RayBox(origin, inv_d, nodes_[node.left + 1].lo, nodes_[node.left + 1].hi,
+                              t_min, best_t, &tb);
+    // Push the farther child first so that the nearer one is visited first.
+    if (hit_a && hit_b) {
+      const bool a_first = ta <= tb;
+      stack[top++] = a_first ? node.left + 1 : node.left;
+      stack[top++] = a_first ? node.left : node.left + 1;
+    } else if (hit_a) {
+      stack[top++] = node.left;
+    } else if (hit_b) {
+      stack[top++] = node.left + 1;
+    }
+  }
+  if (best.triangle < 0) return std::nullopt;
+  return best;
+}
+
+Vec3 MeshRaycaster::SamplePoint(std::mt19937_64& rng, int* triangle) const {
+  const double u = Uniform01(rng) * total_area_;
+  int i = static_cast<int>(std::upper_bound(cumulative_area_.begin(), cumulative_area_.end(), u) -
+                           cumulative_area_.begin());
+  i = std::min(i, static_cast<int>(cumulative_area_.size()) - 1);
+  double r1 = Uniform01(rng), r2 = Uniform01(rng);
+  if (r1 + r2 > 1.0) {
+    r1 = 1.0 - r1;
+    r2 = 1.0 - r2;
+  }
+  const Eigen::Vector3i& t = mesh_.triangles[i];
+  if (triangle) *triangle = i;
+  return mesh_.vertices[t[0]] + r1 * (mesh_.vertices[t[1]] - mesh_.vertices[t[0]]) +
+         r2 * (mesh_.vertices[t[2]] - mesh_.vertices[t[0]]);
+}
+
+}  // namespace wrap::detail

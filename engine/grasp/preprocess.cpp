@@ -1,0 +1,370 @@
+#include "grasp/preprocess.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <memory>
+#include <random>
+
+#include "grasp/detail/grasp_sampler.h"
+#include "grasp/detail/gripper_collision.h"
+#include "grasp/detail/mesh_raycaster.h"
+#include "grasp/detail/parallel.h"
+#include "robot/catalog.h"
+
+namespace wrap {
+
+namespace {
+
+using detail::GraspCandidate;
+using Clock = std::chrono::steady_clock;
+
+// SplitMix64 of a and b: independent seeds for the tasks of one run.
+std::uint64_t MixSeed(std::uint64_t a, std::uint64_t b) {
+  std::uint64_t z = a + 0x9E3779B97F4A7C15ull * (b + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+Error Stopped(const RunContext& ctx, const std::string& where) {
+  return Error{ctx.cancelled() ? ErrorCode::kCancelled : ErrorCode::kTimeout,
+               "preprocess: " + std::string(ctx.cancelled() ? "cancelled" : "time limit reached") +
+                   " during " + where};
+}
+
+double AngleBetween(const Vec3& a, const Vec3& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+bool SameMesh(const TriangleMesh& a, const TriangleMesh& b) {
+  return a.vertices == b.vertices && a.triangles == b.triangles;
+}
+
+// Distance of point c from the line through x along unit u [m].
+double LineDistance(const Vec3& c, const Vec3& x, const Vec3& u) {
+  return (c - x - (c - x).dot(u) * u).norm();
+}
+
+// Farthest-point order of n items: start from the best quality, then repeatedly the item
+// farthest (position, plus approach angle times rot_scale) from those chosen, mildly weighted by
+// quality. Ties go to the lower index: deterministic. Stops early (short) when ctx says so.
+std::vector<int> FarthestPointOrder(const std::vector<Vec3>& x, const std::vector<Vec3>& a,
+                                    const std::vector<double>& quality, int n, double rot_scale,
+                                    const RunContext& ctx) {
+  const int m = static_cast<int>(x.size());
+  std::vector<int> order;
+  if (m == 0 || n <= 0) return order;
+  int next = 0;
+  for (int i = 1; i < m; ++i) {
+    if (quality[i] > quality[next]) next = i;
+  }
+  std::vector<double> min_dist(m, std::numeric_limits<double>::infinity());
+  std::vector<char> taken(m, 0);
+  while (next >= 0 && static_cast<int>(order.size()) < n) {
+    if (order.size() % 16 == 15 && ctx.ShouldStop()) break;
+    order.push_back(next);
+    taken[next] = 1;
+    for (int i = 0; i < m; ++i) {
+      if (taken[i]) continue;
+      const double ang = rot_scale * AngleBetween(a[i], a[next]);
+      min_dist[i] = std::min(min_dist[i], std::sqrt((x[i] - x[next]).squaredNorm() + ang * ang));
+    }
+    next = -1;
+    double best = -1.0;
+    for (int i = 0; i < m; ++i) {
+      if (taken[i]) continue;
+      const double score = min_dist[i] * (0.75 + 0.25 * quality[i]);
+      if (score > best) {
+        best = score;
+        next = i;
+      }
+    }
+  }
+  return order;
+}
+
+class Lap {
+ public:
+  explicit Lap(StageTimes& times) : times_(times), last_(Clock::now()), start_(last_) {}
+  void operator()(const std::string& key) {
+    const auto now = Clock::now();
+    times_[key] += std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+  }
+  void Total() { times_["total"] = std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+ private:
+  StageTimes& times_;
+  Clock::time_point last_, start_;
+};
+
+Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
+                         const PreprocessOptions& options, RunContext& ctx) {
+  Preprocessed out;
+  Lap lap(out.times);
+  out.grasps_per_set = options.grasps > 0 ? options.grasps : project.planner.grasps;
+  if (out.grasps_per_set <= 0) {
+    return Fail(ErrorCode::kInvalidInput,
+                "preprocess: grasp-set size must be positive (planner.grasps is " +
+                    std::to_string(project.planner.grasps) + ")");
+  }
+  out.friction = options.friction.value_or(project.table.friction);
+  if (!(out.friction > 0.0) || !std::isfinite(out.friction)) {
+    return Fail(ErrorCode::kInvalidInput, "preprocess: friction coefficient must be positive");
+  }
+  out.seed = ctx.rng()();
+
+  // Subassemblies: parts in final relative poses, mass and COM.
+  auto subs = BuildSubassemblies(project, check);
+  if (!subs) return std::unexpected(subs.error());
+  out.subassemblies = std::move(*subs);
+  const int num_parts = static_cast<int>(project.parts.size());
+  const int num_subs = static_cast<int>(out.subassemblies.size());
+
+  // End effectors: the options' or those of the robots, in robot order.
+  std::vector<std::string> names = options.end_effectors;
+  if (names.empty()) {
+    for (const Robot& r : project.robots) {
+      if (std::find(names.begin(), names.end(), r.end_effector) == names.end()) {
+        names.push_back(r.end_effector);
+      }
+    }
+  }
+  std::vector<EndEffector> effectors;
+  for (const std::string& name : names) {
+    auto ee = LoadEndEffector(name);
+    if (!ee) return Fail(ee.error().code, "preprocess: " + ee.error().message);
+    effectors.push_back(std::move(*ee));
+  }
+  out.end_effectors = names;
+  const int num_ee = static_cast<int>(effectors.size());
+  lap("subassemblies");
+
+  // Parts with identical meshes (the same file: legs, arms, cube blocks) share their hull,
+  // raycaster and grasp candidates, which are all in the part frame: `same[p]` is the first.
+  std::vector<int> same(num_parts);
+  for (int p = 0; p < num_parts; ++p) {
+    same[p] = p;
+    for (int q = 0; q < p; ++q) {
+      if (same[q] == q && SameMesh(check.parts[p].mesh, check.parts[q].mesh)) {
+        same[p] = q;
+        break;
+      }
+    }
+  }
+  std::vector<int> unique_parts;
+  for (int p = 0; p < num_parts; ++p) {
+    if (same[p] == p) unique_parts.push_back(p);
+  }
+  const int num_unique = static_cast<int>(unique_parts.size());
+
+  // Convex hulls: each part's, then each subassembly's from its parts' hull vertices.
+  std::vector<Result<ConvexHull>> part_hulls(num_parts, Fail(ErrorCode::kInternal, ""));
+  detail::ParallelFor(num_unique, options.parallel, [&](int u) {
+    if (ctx.ShouldStop()) return;
+    const int p = unique_parts[u];
+    part_hulls[p] = ComputeConvexHull(check.parts[p].mesh, options.hull);
+  });
+  if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "convex hulls"));
+  for (int p = 0; p < num_parts; ++p) {
+    if (same[p] != p) part_hulls[p] = part_hulls[same[p]];
+    if (!part_hulls[p]) {
+      return Fail(part_hulls[p].error().code, "preprocess: part '" + project.parts[p].name +
+                                                  "': " + part_hulls[p].error().message);
+    }
+  }
+  std::vector<Error> errors(num_subs);
+  detail::ParallelFor(num_subs, options.parallel, [&](int s) {
+    if (ctx.ShouldStop()) return;
+    Subassembly& sub = out.subassemblies[s];
+    std::vector<Vec3> points;
+    for (size_t k = 0; k < sub.parts.size(); ++k) {
+      for (const Vec3& v : part_hulls[sub.parts[k]]->mesh.vertices)
+        points.push_back(sub.X_AP[k] * v);
+    }
+    auto hull = ComputeConvexHull(points, options.hull);
+    if (!hull) {
+      errors[s] = hull.error();
+      return;
+    }
+    sub.hull = std::move(*hull);
+  });
+  if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "convex hulls"));
+  for (int s = 0; s < num_subs; ++s) {
+    if (!errors[s].message.empty()) {
+      return Fail(errors[s].code, "preprocess: subassembly '" + out.subassemblies[s].name +
+                                      "': " + errors[s].message);
+    }
+  }
+  lap("hulls");
+
+  // Stable placements.
+  detail::ParallelFor(num_subs, options.parallel, [&](int s) {
+    if (ctx.ShouldStop()) return;
+    Subassembly& sub = out.subassemblies[s];
+    sub.placements = ComputeStablePlacements(sub.hull, sub.com_A, options.placements);
+  });
+  if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "stable placements"));
+  lap("placements");
+
+  // Table positions the robots reach.
+  if (options.compute_table_slots) {
+    TableSlotOptions slot_options = options.table_slots;
+    slot_options.parallel = slot_options.parallel && options.parallel;
+    auto slots = ComputeTableSlots(project, options.project_file, slot_options,
+                                   MixSeed(out.seed, 0x51075), ctx);
+    if (!slots) return std::unexpected(slots.error());
+    out.table_slots = std::move(*slots);
+  }
+  lap("table_slots");
+
+  // Grasp candidates per part and end effector, each checked against its own part.
+  std::vector<const TriangleMesh*> meshes;
+  std::vector<Iso3> X_AP;
+  for (int p = 0; p < num_parts; ++p) {
+    meshes.push_back(&check.parts[p].mesh);
+    X_AP.push_back(ToIsometry(project.parts[p].assembled_pose));
+  }
+  // The collision world (FCL's trees, built serially) alongside the parts' raycasters.
+  Result<detail::GripperCollision> world = Fail(ErrorCode::kInternal, "not built");
+  std::vector<std::unique_ptr<detail::MeshRaycaster>> rays(num_parts);
+  detail::ParallelFor(num_unique + 1, options.parallel, [&](int task) {
+    if (task == 0) {
+      world = detail::GripperCollision::Build(meshes, X_AP, effectors, ctx);
+    } else if (!ctx.ShouldStop()) {
+      const int p = unique_parts[task - 1];
+      rays[p] = std::make_unique<detail::MeshRaycaster>(check.parts[p].mesh);
+    }
+  });
+  if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp sampling"));
+  if (!world) return Fail(world.error().code, "preprocess: " + world.error().message);
+  const int pool = std::max(out.grasps_per_set * std::max(1, options.candidate_factor), 8);
+  const int max_samples = pool * std::max(1, options.sample_factor);
+  std::vector<std::vector<GraspCandidate>> candidates(num_parts * num_ee);
+  detail::ParallelFor(num_unique * num_ee, options.parallel, [&](int task) {
+    const int p = unique_parts[task / num_ee], e = task % num_ee;
+    detail::GripperCollision local = *world;
+    const int only[1] = {p};
+    local.EnableOnly(only);
+    std::mt19937_64 rng(MixSeed(out.seed, static_cast<std::uint64_t>(task) + 1));
+    detail::SamplerInput in;
+    in.part = rays[p].get();
+    in.part_index = p;
+    in.X_AP = X_AP[p];
+    in.ee = &effectors[e];
+    in.ee_index = e;
+    in.friction = out.friction;
+    in.wanted = pool;
+    in.max_samples = max_samples;
+    candidates[p * num_ee + e] =
+        effectors[e].kind == EndEffectorKind::kVacuum
+            ? detail::SampleVacuum(in, options.vacuum, local, rng, ctx)
+            : detail::SampleTwoFinger(in, options.two_finger, local, rng, ctx);
+  });
+  if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp sampling"));
+  for (int p = 0; p < num_parts; ++p) {
+    if (same[p] == p) continue;
+    for (int e = 0; e < num_ee; ++e) {
+      candidates[p * num_ee + e] = candidates[same[p] * num_ee + e];
+      for (GraspCandidate& c : candidates[p * num_ee + e]) c.grasp.part = p;
+    }
+  }
+  lap("grasp_candidates");
+
+  // Per subassembly and end effector: drop candidates that hit another part, score, spread.
+  for (Subassembly& sub : out.subassemblies) sub.grasp_sets.resize(num_ee);
+  detail::ParallelFor(num_subs * num_ee, options.parallel, [&](int task) {
+    const int s = task / num_ee, e = task % num_ee;
+    Subassembly& sub = out.subassemblies[s];
+    const EndEffector& ee = effectors[e];
+    detail::GripperCollision local = *world;
+    const double diag = sub.aabb_A.size().norm();
+    const double length = std::max(1e-6, 0.5 * diag);
+    std::vector<const GraspCandidate*> kept;
+    std::vector<Vec3> x, a;
+    std::vector<double> quality;
+    int checked = 0;
+    for (size_t k = 0; k < sub.parts.size(); ++k) {
+      const int p = sub.parts[k];
+      std::vector<int> others;
+      for (int o : sub.parts) {
+        if (o != p) others.push_back(o);
+      }
+      local.EnableOnly(others);
+      const Iso3& X_AP_k = sub.X_AP[k];
+      for (const GraspCandidate& c : candidates[p * num_ee + e]) {
+        if (++checked % 32 == 0 && ctx.ShouldStop()) return;
+        if (!others.empty()) {
+          Iso3 X_AT = X_AP_k * c.grasp.X_PG;
+          double opening = 0.0;
+          if (ee.kind == EndEffectorKind::kVacuum) {
+            X_AT.translation() -= options.vacuum.standoff_m * (X_AP_k.linear() * c.approach_P);
+          } else {
+            opening = c.grasp.width_m + 2.0 * options.two_finger.clearance_m;
+          }
+          if (local.Collides(e, X_AT, opening)) continue;
+        }
+        const Vec3 x_A = X_AP_k * c.center_P;
+        const Vec3 axis_A = X_AP_k.linear() * c.axis_P;
+        const double com_term = std::exp(-LineDistance(sub.com_A, x_A, axis_A) / length);
+        kept.push_back(&c);
+        x.push_back(x_A);
+        a.push_back(X_AP_k.linear() * c.approach_P);
+        quality.push_back(ee.kind == EndEffectorKind::kVacuum
+                              ? (c.slack + com_term) / 2.0
+                              : (c.slack + c.pad_fraction + com_term) / 3.0);
+      }
+    }
+    GraspSet set;
+    set.end_effector = ee.name;
+    set.kind = ee.kind;
+    set.candidates = static_cast<int>(kept.size());
+    for (int i : FarthestPointOrder(x, a, quality, out.grasps_per_set, 0.1 * diag, ctx)) {
+      Grasp g = kept[i]->grasp;
+      g.quality = quality[i];
+      set.grasps.push_back(std::move(g));
+    }
+    sub.grasp_sets[e] = std::move(set);
+  });
+  if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp selection"));
+  lap("grasp_sets");
+
+  for (const Subassembly& sub : out.subassemblies) {
+    if (sub.placements.empty()) {
+      out.warnings.push_back("subassembly '" + sub.name +
+                             "': no stable placement (it cannot be set down on the table)");
+    }
+    int total = 0;
+    for (const GraspSet& set : sub.grasp_sets) total += static_cast<int>(set.grasps.size());
+    if (total == 0 && num_ee > 0) {
+      out.warnings.push_back("subassembly '" + sub.name + "': no grasp for any end effector");
+    }
+  }
+  lap.Total();
+  return out;
+}
+
+}  // namespace
+
+const Subassembly* Preprocessed::Find(const std::string& name) const {
+  for (const Subassembly& s : subassemblies) {
+    if (s.name == name) return &s;
+  }
+  return nullptr;
+}
+
+Result<Preprocessed> Preprocess(const Project& project, const ProjectCheck& check,
+                                const PreprocessOptions& options, RunContext& ctx) {
+  ScopedStageTimer timer(ctx, "grasp");
+  // The catch barrier of this stage: anything thrown below (allocation, TBB) becomes an Error.
+  try {
+    return Run(project, check, options, ctx);
+  } catch (const std::exception& e) {
+    return Fail(ErrorCode::kInternal, std::string("preprocess: unexpected exception: ") + e.what());
+  }
+}
+
+}  // namespace wrap
