@@ -44,6 +44,22 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   CLI::Option* seed_option =
       preprocess->add_option("--seed", seed, "Random seed (default: the project's)");
 
+  RenderArgs ren;
+  CLI::App* render = app.add_subcommand(
+      "render", "Draw the cell offscreen: PNGs of the initial scene and the goal, a contact sheet");
+  render->add_option("PROJECT", ren.project, "Project file (.json)")->required();
+  render->add_option("-o,--output", ren.output, "Folder for the images (created)")->required();
+  render->add_option("--plan", ren.plan, "Plan file (.json) to animate (not supported yet)");
+  CLI::Option* frames = render->add_option("--frames", ren.frames, "Frames evenly along the plan");
+  render->add_option("--at", ren.at, "Times along the plan [s], e.g. 0,2.5,10")->excludes(frames);
+  render->add_option("--size", ren.size, "Image size WIDTHxHEIGHT [px] (default 960x720)");
+  render->add_option("--camera", ren.camera, "AZIMUTH,ELEVATION[,DISTANCE] [deg, deg, m]");
+  render->add_option("--backend", ren.backend, "Offscreen GL: egl (default) or osmesa");
+  render->add_flag("--goal", ren.goal, "Only the assembled goal, not the initial scene");
+  render->add_option("--explode", ren.explode,
+                     "Also the goal exploded along the insertion axes by F times its size");
+  render->add_option("--video", ren.video, "Also encode the frames as an MP4 (needs ffmpeg)");
+  render->add_flag("--no-shadows", ren.no_shadows, "Draw without shadows (faster)");
 
   // CLI11 takes arguments in reverse order.
   std::vector<std::string> reversed(args.rbegin(), args.rend());
@@ -60,6 +76,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (seed_option->count() > 0) pre.seed = seed;
     return Preprocess(pre, out, err);
   }
+  if (render->parsed()) return Render(ren, out, err);
   // No subcommand: the GUI will open here once it exists; until then explain what there is.
   out << app.help();
   return 0;

@@ -14,8 +14,8 @@ PACKAGES=(
   libfcl-dev libccd-dev liburdfdom-dev
   # wrench LP: Clp (the reference LP solver behind the dense simplex)
   coinor-libclp-dev
-  # sim: MuJoCo (its CMake config also wants libgl-dev and libqhull-dev)
-  libmujoco-dev libqhull-dev
+  # sim: MuJoCo (its CMake config also wants libgl-dev and libqhull-dev, listed elsewhere here)
+  libmujoco-dev
   # ui: GL, offscreen contexts (EGL, OSMesa), PNG (stb), window and widgets
   libstb-dev
   libgl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libimgui-dev

@@ -1,0 +1,332 @@
+// `wrap render` end to end, as a separate process (one GL platform library per process): golden
+// images, EGL and OSMesa agreeing, no DISPLAY needed, and clear exit-2 errors on bad input.
+//
+// Golden images live in tests/golden/render; WRAP_UPDATE_GOLDEN=1 rewrites them (see
+// tests/golden/README.md). A mismatch writes actual, expected and diff PNGs under
+// WRAP_TEST_OUT_DIR/golden_failures.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "render/image.h"
+
+extern char** environ;
+
+namespace wrap::render {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Golden tolerance: 99% of channel values within 3 levels.
+constexpr int kTolerance = 3;
+constexpr double kFractionWithin = 0.99;
+
+struct ProcessRun {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string Slurp(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path OutDir(const std::string& name) {
+  const fs::path dir = fs::path(WRAP_TEST_OUT_DIR) / name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+// Runs the `wrap` executable with `args`, without DISPLAY or WAYLAND_DISPLAY (as on a CI machine
+// with no display) and with `env` applied (nullopt removes a variable).
+ProcessRun RunWrap(const std::vector<std::string>& args,
+                   const std::map<std::string, std::optional<std::string>>& env = {}) {
+  std::map<std::string, std::optional<std::string>> changes = env;
+  changes.try_emplace("DISPLAY", std::nullopt);
+  changes.try_emplace("WAYLAND_DISPLAY", std::nullopt);
+  std::vector<std::string> vars;
+  for (char** e = environ; *e; ++e) {
+    const std::string var(*e);
+    if (!changes.contains(var.substr(0, var.find('=')))) vars.push_back(var);
+  }
+  for (const auto& [name, value] : changes) {
+    if (value) vars.push_back(name + "=" + *value);
+  }
+  std::vector<char*> envp;
+  for (std::string& v : vars) envp.push_back(v.data());
+  envp.push_back(nullptr);
+
+  std::vector<std::string> argv_s = {WRAP_EXE};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+
+  fs::create_directories(WRAP_TEST_OUT_DIR);
+  const std::string tag = std::to_string(::getpid()) + "_" + std::to_string(std::rand());
+  const fs::path out_file = fs::path(WRAP_TEST_OUT_DIR) / ("stdout_" + tag);
+  const fs::path err_file = fs::path(WRAP_TEST_OUT_DIR) / ("stderr_" + tag);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  posix_spawn_file_actions_addopen(&actions, 2, err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  pid_t pid = 0;
+  ProcessRun run;
+  const int spawned = posix_spawn(&pid, WRAP_EXE, &actions, nullptr, argv.data(), envp.data());
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) {
+    ADD_FAILURE() << "cannot run " << WRAP_EXE;
+    return run;
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  run.out = Slurp(out_file);
+  run.err = Slurp(err_file);
+  fs::remove(out_file);
+  fs::remove(err_file);
+  return run;
+}
+
+std::string Project(const std::string& name) {
+  return (fs::path(WRAP_SOURCE_DIR) / "projects" / (name + ".json")).string();
+}
+
+// Compares a rendered image with its golden twin (or rewrites the twin when asked to).
+void ExpectMatchesGolden(const fs::path& actual_file, const std::string& golden_name) {
+  const fs::path golden = fs::path(WRAP_GOLDEN_DIR) / golden_name;
+  auto actual = ReadPng(actual_file);
+  ASSERT_TRUE(actual.has_value()) << actual.error().message;
+  if (const char* update = std::getenv("WRAP_UPDATE_GOLDEN");
+      update && std::string(update) == "1") {
+    fs::create_directories(golden.parent_path());
+    ASSERT_TRUE(WritePng(*actual, golden).has_value());
+    GTEST_SKIP() << "rewrote " << golden;
+  }
+  auto expected = ReadPng(golden);
+  ASSERT_TRUE(expected.has_value())
+      << expected.error().message << " (create it with WRAP_UPDATE_GOLDEN=1, see "
+      << "tests/golden/README.md)";
+  const ImageDifference d = CompareImages(*actual, *expected, kTolerance);
+  if (d.same_size && d.fraction_within >= kFractionWithin) return;
+  const fs::path dir = fs::path(WRAP_TEST_OUT_DIR) / "golden_failures";
+  fs::create_directories(dir);
+  const std::string stem = fs::path(golden_name).stem().string();
+  (void)WritePng(*actual, dir / (stem + "_actual.png"));
+  (void)WritePng(*expected, dir / (stem + "_expected.png"));
+  if (d.same_size)
+    (void)WritePng(DifferenceImage(*actual, *expected, kTolerance), dir / (stem + "_diff.png"));
+  ADD_FAILURE() << golden_name << ": " << (d.same_size ? "" : "size differs; ")
+                << 100.0 * d.fraction_within << "% of channels within +-" << kTolerance << " (need "
+                << 100.0 * kFractionWithin << "%), max difference " << d.max_difference << "; see "
+                << dir.string();
+}
+
+struct GoldenCase {
+  std::string project;
+  std::vector<std::string> options;
+  std::string image;   // file written by wrap render
+  std::string golden;  // name under tests/golden/render
+};
+
+void PrintTo(const GoldenCase& c, std::ostream* os) { *os << c.golden; }
+
+class Golden : public ::testing::TestWithParam<GoldenCase> {};
+
+TEST_P(Golden, MatchesWithinTolerance) {
+  const GoldenCase& c = GetParam();
+  const fs::path dir = OutDir("golden_" + fs::path(c.golden).stem().string());
+  std::vector<std::string> args = {"render",     Project(c.project), "-o",
+                                   dir.string(), "--size",           "160x120"};
+  args.insert(args.end(), c.options.begin(), c.options.end());
+  const ProcessRun r = RunWrap(args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  ExpectMatchesGolden(dir / c.image, "render/" + c.golden);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Scenes, Golden,
+    ::testing::Values(GoldenCase{"stool", {}, "initial.png", "stool_initial.png"},
+                      GoldenCase{"cross_openarm", {}, "initial.png", "cross_openarm_initial.png"},
+                      GoldenCase{"half_stool",
+                                 {"--goal", "--explode", "0.5"},
+                                 "goal_exploded.png",
+                                 "half_stool_goal_exploded.png"}),
+    [](const auto& p) { return fs::path(p.param.golden).stem().string(); });
+
+TEST(RenderCli, EglAndOsmesaDrawTheSameImage) {
+  std::map<std::string, Image> images;
+  for (const std::string backend : {"egl", "osmesa"}) {
+    const fs::path dir = OutDir("backend_" + backend);
+    const ProcessRun r = RunWrap({"render", Project("stool"), "-o", dir.string(), "--size",
+                                  "160x120", "--backend", backend});
+    ASSERT_EQ(r.code, 0) << backend << ": " << r.err;
+    EXPECT_NE(r.out.find(backend == "egl" ? "EGL" : "OSMesa"), std::string::npos) << r.out;
+    auto image = ReadPng(dir / "initial.png");
+    ASSERT_TRUE(image.has_value());
+    images[backend] = *image;
+  }
+  const ImageDifference d = CompareImages(images["egl"], images["osmesa"], kTolerance);
+  ASSERT_TRUE(d.same_size);
+  EXPECT_GE(d.fraction_within, kFractionWithin) << "max difference " << d.max_difference;
+}
+
+TEST(RenderCli, WorksWithoutDisplayAndWritesTheSheet) {
+  const fs::path dir = OutDir("no_display");
+  const ProcessRun r = RunWrap({"render", Project("cross"), "-o", dir.string(), "--size", "200x150",
+                                "--explode", "0.4", "--camera", "120,-45"},
+                               {{"DISPLAY", std::nullopt}, {"XAUTHORITY", std::nullopt}});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* f : {"initial.png", "goal.png", "goal_exploded.png", "contact_sheet.png"}) {
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+    EXPECT_NE(r.out.find(f), std::string::npos) << r.out;
+  }
+  auto frame = ReadPng(dir / "initial.png");
+  ASSERT_TRUE(frame.has_value());
+  EXPECT_EQ(frame->width, 200);
+  EXPECT_EQ(frame->height, 150);
+  // Three snapshots side by side with a title and captions.
+  auto sheet = ReadPng(dir / "contact_sheet.png");
+  ASSERT_TRUE(sheet.has_value());
+  EXPECT_GT(sheet->width, 3 * 200);
+  EXPECT_GT(sheet->height, 150);
+  // Not blank: a rendered frame has many colours.
+  std::set<int> colours;
+  for (size_t i = 0; i + 2 < frame->rgb.size(); i += 3) {
+    colours.insert(frame->rgb[i] << 16 | frame->rgb[i + 1] << 8 | frame->rgb[i + 2]);
+  }
+  EXPECT_GT(colours.size(), 200u);
+}
+
+struct BadCase {
+  std::string name;
+  std::vector<std::string> options;
+  std::string phrase;  // expected in the message
+};
+
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
+
+class BadInput : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadInput, ExitsTwoWithAClearMessage) {
+  const BadCase& c = GetParam();
+  const fs::path dir = OutDir("bad_" + c.name);
+  std::vector<std::string> args = {"render", Project("stool"), "-o", dir.string()};
+  args.insert(args.end(), c.options.begin(), c.options.end());
+  const ProcessRun r = RunWrap(args);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(c.phrase), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "initial.png"));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Options, BadInput,
+    ::testing::Values(BadCase{"backend", {"--backend", "vulkan"}, "unknown GL backend 'vulkan'"},
+                      BadCase{"size_zero", {"--size", "0x480"}, "--size"},
+                      BadCase{"size_text", {"--size", "big"}, "WIDTHxHEIGHT"},
+                      BadCase{"size_huge", {"--size", "100000x100"}, "between 16 and 8192"},
+                      BadCase{"camera", {"--camera", "10"}, "AZIMUTH,ELEVATION"},
+                      BadCase{"elevation", {"--camera", "10,120"}, "elevation"},
+                      BadCase{"explode", {"--explode", "-1"}, "--explode"},
+                      BadCase{"plan", {"--plan", "plan.json"}, "plans are not supported yet"},
+                      BadCase{"frames", {"--frames", "5"}, "need --plan"},
+                      BadCase{"at", {"--at", "0,1"}, "need --plan"}),
+    [](const auto& p) { return p.param.name; });
+
+TEST(RenderCli, NoGlExitsTwoNamingWhatWasTried) {
+  // glvnd's libEGL with no vendor library: no EGL display of any kind.
+  const fs::path dir = OutDir("no_gl");
+  const ProcessRun r =
+      RunWrap({"render", Project("stool"), "-o", dir.string(), "--size", "160x120"},
+              {{"__EGL_VENDOR_LIBRARY_FILENAMES", "/nonexistent/vendor.json"}});
+  if (r.code == 0) GTEST_SKIP() << "this libEGL is not glvnd's; cannot hide the driver";
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("EGL: no offscreen context"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("surfaceless"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--backend osmesa"), std::string::npos) << r.err;
+}
+
+// A stand-in ffmpeg on PATH: records its arguments and the concat list, writes the output file
+// (its last argument), and fails when asked to.
+fs::path FakeFfmpeg(bool fail) {
+  const fs::path dir = fs::path(WRAP_TEST_OUT_DIR) / (fail ? "fake_ffmpeg_fail" : "fake_ffmpeg");
+  fs::create_directories(dir);
+  const fs::path exe = dir / "ffmpeg";
+  std::ofstream(exe) << "#!/bin/sh\n"
+                     << "echo \"$@\" > \"" << (dir / "args").string() << "\"\n"
+                     << "for a; do last=\"$a\"; case \"$a\" in *.ffconcat) cp \"$a\" \""
+                     << (dir / "list").string() << "\";; esac; done\n"
+                     << (fail ? "echo 'Unknown encoder libx264' >&2; exit 1\n"
+                              : "echo video > \"$last\"\n");
+  fs::permissions(exe, fs::perms::owner_all);
+  return dir;
+}
+
+TEST(RenderCli, VideoGoesThroughFfmpeg) {
+  const fs::path bin = FakeFfmpeg(false);
+  const fs::path dir = OutDir("video_ok");
+  const fs::path video = dir / "cell.mp4";
+  const std::string path = bin.string() + ":/usr/bin:/bin";
+  ProcessRun r = RunWrap({"render", Project("stool"), "-o", dir.string(), "--size", "160x120",
+                          "--video", video.string()},
+                         {{"PATH", path}});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(video));
+  EXPECT_NE(r.out.find("cell.mp4"), std::string::npos) << r.out;
+  const std::string args = Slurp(bin / "args");
+  EXPECT_NE(args.find("-f concat"), std::string::npos) << args;
+  EXPECT_NE(args.find("libx264"), std::string::npos) << args;
+  const std::string list = Slurp(bin / "list");
+  EXPECT_NE(list.find("initial.png"), std::string::npos) << list;
+  EXPECT_NE(list.find("goal.png"), std::string::npos) << list;
+
+  const fs::path failing = FakeFfmpeg(true);
+  r = RunWrap({"render", Project("stool"), "-o", OutDir("video_fail").string(), "--size", "160x120",
+               "--video", (dir / "bad.mp4").string()},
+              {{"PATH", failing.string() + ":/usr/bin:/bin"}});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("ffmpeg failed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("Unknown encoder"), std::string::npos) << r.err;
+}
+
+TEST(RenderCli, UnwritableOutputFolderExitsTwo) {
+  // A folder below a regular file cannot be made, even by root.
+  const fs::path file = fs::path(WRAP_TEST_OUT_DIR) / "a_file";
+  fs::create_directories(file.parent_path());
+  std::ofstream(file) << "x";
+  const ProcessRun r = RunWrap({"render", Project("stool"), "-o", (file / "sub").string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("output folder"), std::string::npos) << r.err;
+}
+
+TEST(RenderCli, MissingProjectAndMissingFfmpegExitTwo) {
+  ProcessRun r = RunWrap({"render", "no_such_project.json", "-o", OutDir("missing").string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no_such_project.json"), std::string::npos) << r.err;
+  // No ffmpeg on an empty PATH: said before anything is drawn.
+  const fs::path empty = fs::path(WRAP_TEST_OUT_DIR) / "empty_path";
+  fs::create_directories(empty);
+  r = RunWrap({"render", Project("stool"), "-o", OutDir("video").string(), "--video",
+               (fs::path(WRAP_TEST_OUT_DIR) / "v.mp4").string()},
+              {{"PATH", empty.string()}});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("ffmpeg"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace wrap::render
