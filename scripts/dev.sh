@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's commands: install the dependencies, build, then run the demo or the tests.
-#   scripts/dev.sh demo   install, build, and run the main job on the built-in stool example
+#   scripts/dev.sh demo   install, build, and run the main job on the built-in stool example:
+#                         validate, describe, preprocess and render snapshots into out/stool/
 #   scripts/dev.sh test   install, build, and run the whole test suite (what CI runs)
 #   scripts/dev.sh build  install and build only
 # BUILD_DIR (default: build) and BUILD_TYPE (default: RelWithDebInfo) may be set.
@@ -20,6 +21,8 @@ case "$mode" in
   demo)
     "$BUILD_DIR/app/wrap" validate projects/stool.json
     "$BUILD_DIR/app/wrap" info projects/stool.json
+    "$BUILD_DIR/app/wrap" render projects/stool.json -o out/stool --explode 0.4
+    "$BUILD_DIR/app/wrap" preprocess projects/stool.json -o out/stool/preprocess.json
     ;;
   test)
     ctest --test-dir "$BUILD_DIR" --output-on-failure --parallel "$(nproc)"
