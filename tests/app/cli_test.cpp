@@ -6,31 +6,12 @@
 #include <random>
 #include <sstream>
 
-#include "cli.h"
+#include "cli_runner.h"
 
 namespace wrap::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CliRun {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
-
-CliRun Wrap(const std::vector<std::string>& args) {
-  std::ostringstream out, err;
-  CliRun r;
-  r.code = RunCli(args, out, err);
-  r.out = out.str();
-  r.err = err.str();
-  return r;
-}
-
-std::string Project(const std::string& name) {
-  return (fs::path(WRAP_SOURCE_DIR) / "projects" / (name + ".json")).string();
-}
 
 fs::path TempFile(const std::string& name, const std::string& contents) {
   const fs::path dir = fs::temp_directory_path() / "wrap_cli_test";

@@ -6,30 +6,12 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "cli.h"
+#include "cli_runner.h"
 
 namespace wrap::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CliResult {
-  int code = -1;
-  std::string out, err;
-};
-
-CliResult Wrap(const std::vector<std::string>& args) {
-  std::ostringstream out, err;
-  CliResult r;
-  r.code = RunCli(args, out, err);
-  r.out = out.str();
-  r.err = err.str();
-  return r;
-}
-
-std::string Project(const std::string& name) {
-  return (fs::path(WRAP_SOURCE_DIR) / "projects" / (name + ".json")).string();
-}
 
 fs::path TempDir() {
   const fs::path dir = fs::temp_directory_path() / "wrap_preprocess_cli_test";
@@ -45,7 +27,7 @@ nlohmann::json ReadJson(const fs::path& file) {
 TEST(CliPreprocess, StoolPrintsSummaryAndWritesJson) {
   const fs::path json = TempDir() / "stool_pre.json";
   fs::remove(json);
-  const CliResult r = Wrap({"preprocess", Project("stool"), "-o", json.string()});
+  const CliRun r = Wrap({"preprocess", Project("stool"), "-o", json.string()});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("Subassemblies"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("seat+leg1"), std::string::npos);
@@ -100,7 +82,7 @@ TEST(CliPreprocess, OptionsAndDeterminism) {
 }
 
 TEST(CliPreprocess, BadInputExitsTwo) {
-  CliResult r = Wrap({"preprocess", "/nonexistent/dir/project.json"});
+  CliRun r = Wrap({"preprocess", "/nonexistent/dir/project.json"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("/nonexistent/dir/project.json"), std::string::npos) << r.err;
   EXPECT_EQ(Wrap({"preprocess"}).code, 2);
