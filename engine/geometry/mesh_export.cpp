@@ -89,6 +89,19 @@ void AppendTriangle(std::string& out, const Eigen::Vector3i& t, int base) {
   AppendInt(out, int64_t{t[2]} + base);
 }
 
+// The body PLY and OFF share: one vertex per line (shortest exact text), then "3 a b c" faces.
+void AppendVerticesAndCountedFaces(std::string& out, const TriangleMesh& mesh, double scale) {
+  for (const Vec3& v : mesh.vertices) {
+    AppendVertexShortest(out, v, scale);
+    out += '\n';
+  }
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    out += "3 ";
+    AppendTriangle(out, t, 0);
+    out += '\n';
+  }
+}
+
 }  // namespace
 
 Result<void> WriteStl(const std::filesystem::path& path, const TriangleMesh& mesh, double scale) {
@@ -148,15 +161,7 @@ Result<void> WritePly(const std::filesystem::path& path, const TriangleMesh& mes
       "element face ";
   AppendInt(out, static_cast<int64_t>(mesh.triangles.size()));
   out += "\nproperty list uchar int vertex_indices\nend_header\n";
-  for (const Vec3& v : mesh.vertices) {
-    AppendVertexShortest(out, v, scale);
-    out += '\n';
-  }
-  for (const Eigen::Vector3i& t : mesh.triangles) {
-    out += "3 ";
-    AppendTriangle(out, t, 0);
-    out += '\n';
-  }
+  AppendVerticesAndCountedFaces(out, mesh, scale);
   return WriteFileAtomic(path, out);
 }
 
@@ -167,15 +172,7 @@ Result<void> WriteOff(const std::filesystem::path& path, const TriangleMesh& mes
   out += ' ';
   AppendInt(out, static_cast<int64_t>(mesh.triangles.size()));
   out += " 0\n";
-  for (const Vec3& v : mesh.vertices) {
-    AppendVertexShortest(out, v, scale);
-    out += '\n';
-  }
-  for (const Eigen::Vector3i& t : mesh.triangles) {
-    out += "3 ";
-    AppendTriangle(out, t, 0);
-    out += '\n';
-  }
+  AppendVerticesAndCountedFaces(out, mesh, scale);
   return WriteFileAtomic(path, out);
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "../geometry/test_meshes.h"
 #include "geometry/mesh.h"
 #include "robot/cell.h"
 #include "robot/chain.h"
@@ -45,20 +46,7 @@ inline Shape Box(const Vec3& center, const Vec3& half, std::string name = "box")
 }
 
 /// Closed box mesh from `lo` to `hi` [m]: 8 vertices, 12 outward triangles.
-inline TriangleMesh BoxMesh(const Vec3& lo, const Vec3& hi) {
-  TriangleMesh mesh;
-  for (int k = 0; k < 8; ++k) {
-    mesh.vertices.emplace_back((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(),
-                               (k & 4) ? hi.z() : lo.z());
-  }
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    mesh.triangles.emplace_back(q[0], q[1], q[2]);
-    mesh.triangles.emplace_back(q[0], q[2], q[3]);
-  }
-  return mesh;
-}
+inline TriangleMesh BoxMesh(const Vec3& lo, const Vec3& hi) { return test_meshes::MakeBox(lo, hi); }
 
 inline Shape MeshShape(TriangleMesh mesh, std::string name = "mesh") {
   Shape s;
