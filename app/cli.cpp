@@ -46,12 +46,22 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
 
   RenderArgs ren;
   CLI::App* render = app.add_subcommand(
-      "render", "Draw the cell offscreen: PNGs of the initial scene and the goal, a contact sheet");
+      "render",
+      "Draw the cell offscreen: PNGs of the initial scene and the goal, or of a plan's keyframes, "
+      "and a contact sheet");
   render->add_option("PROJECT", ren.project, "Project file (.json)")->required();
   render->add_option("-o,--output", ren.output, "Folder for the images (created)")->required();
-  render->add_option("--plan", ren.plan, "Plan file (.json) to animate (not supported yet)");
-  CLI::Option* frames = render->add_option("--frames", ren.frames, "Frames evenly along the plan");
-  render->add_option("--at", ren.at, "Times along the plan [s], e.g. 0,2.5,10")->excludes(frames);
+  render->add_option("--plan", ren.plan,
+                     "Plan file (.json): draw its keyframes (plan_KKK_TYPE.png) instead of the "
+                     "initial scene and goal");
+  CLI::Option* frames = render->add_option(
+      "--frames", ren.frames,
+      "With --plan: N frames (frame_NNN.png) evenly along the keyframes, frame k showing "
+      "keyframe round(k*(K-1)/(N-1)) (keyframe index = time until plans are retimed)");
+  render->add_option("--at", ren.at,
+                     "With --plan: keyframe indices to draw, e.g. 0,3,7 (0 = initial; "
+                     "frame_NNN.png)")
+      ->excludes(frames);
   render->add_option("--size", ren.size, "Image size WIDTHxHEIGHT [px] (default 960x720)");
   render->add_option("--camera", ren.camera, "AZIMUTH,ELEVATION[,DISTANCE] [deg, deg, m]");
   render->add_option("--backend", ren.backend, "Offscreen GL: egl (default) or osmesa");
@@ -60,6 +70,29 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
                      "Also the goal exploded along the insertion axes by F times its size");
   render->add_option("--video", ren.video, "Also encode the frames as an MP4 (needs ffmpeg)");
   render->add_flag("--no-shadows", ren.no_shadows, "Draw without shadows (faster)");
+
+  PlanArgs plan_args;
+  std::uint64_t plan_seed = 0;
+  double plan_time_limit = 0.0;
+  CLI::App* plan = app.add_subcommand(
+      "plan", "Plan the assembly: a validated multi-robot action plan with keyframes (paper IV-D)");
+  plan->add_option("PROJECT", plan_args.project, "Project file (.json)")->required();
+  plan->add_option("-o,--output", plan_args.output, "Write the plan JSON to this file (atomic)");
+  CLI::Option* plan_seed_option =
+      plan->add_option("--seed", plan_seed, "Random seed (default: the project's)");
+  CLI::Option* plan_time_option = plan->add_option(
+      "--time-limit", plan_time_limit, "Time limit in seconds (default: the project's)");
+  plan->add_option("--wrench", plan_args.wrench,
+                   "Wrench model: full (default), gravity (gravity only) or none");
+  plan->add_option("--force-scale", plan_args.force_scale,
+                   "Scale lambda on the mating force and torque (default 1)");
+  plan->add_option("--planner", plan_args.planner, "Planner variant: counting (default)");
+  plan->add_option("--grasps", plan_args.grasps, "Grasp-set size (default: the project's)")
+      ->check(CLI::PositiveNumber);
+  plan->add_flag("--validate", plan_args.validate,
+                 "Replay the plan with the independent validator; exit 1 if it fails");
+  plan->add_flag("--task-only", plan_args.task_only,
+                 "Stop after the task plan (motion planning is not part of this build yet)");
 
   // CLI11 takes arguments in reverse order.
   std::vector<std::string> reversed(args.rbegin(), args.rend());
@@ -77,6 +110,11 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     return Preprocess(pre, out, err);
   }
   if (render->parsed()) return Render(ren, out, err);
+  if (plan->parsed()) {
+    if (plan_seed_option->count() > 0) plan_args.seed = plan_seed;
+    if (plan_time_option->count() > 0) plan_args.time_limit = plan_time_limit;
+    return PlanCommand(plan_args, out, err);
+  }
   // No subcommand: the GUI will open here once it exists; until then explain what there is.
   out << app.help();
   return 0;

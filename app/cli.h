@@ -32,13 +32,32 @@ struct PreprocessArgs {
 /// grasps per end effector, the table slots, and timings; exit 0, 2 bad input, 3 internal.
 int Preprocess(const PreprocessArgs& args, std::ostream& out, std::ostream& err);
 
+/// Arguments of `wrap plan`.
+struct PlanArgs {
+  std::string project;                ///< Project file.
+  std::string output;                 ///< -o PLAN.json (atomic); empty: not written.
+  std::optional<std::uint64_t> seed;  ///< --seed; absent: the project's planner.seed.
+  std::optional<double> time_limit;   ///< --time-limit [s]; absent: the project's.
+  std::string wrench = "full";        ///< --wrench full|gravity|none.
+  double force_scale = 1.0;           ///< --force-scale lambda.
+  std::string planner = "counting";   ///< --planner variant.
+  int grasps = 0;                     ///< --grasps; 0: the project's planner.grasps.
+  bool validate = false;              ///< --validate with the independent validator.
+  bool task_only = false;             ///< --task-only.
+};
+
+/// `wrap plan PROJECT [-o PLAN.json] ...`: preprocesses, plans, prints the actions in words and
+/// writes the plan JSON; exit 0 solved (and valid with --validate), 1 no plan within the limits
+/// or validation failed, 2 bad input, 3 internal error.
+int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err);
+
 /// Arguments of `wrap render`.
 struct RenderArgs {
   std::string project;           ///< Project file.
   std::string output;            ///< -o DIR: folder for the PNGs (created if missing).
-  std::string plan;              ///< --plan PLAN.json; empty: none (plans are not supported yet).
-  int frames = -1;               ///< --frames N along the plan; negative: not given.
-  std::string at;                ///< --at T1,T2,... [s] along the plan; empty: not given.
+  std::string plan;              ///< --plan PLAN.json; empty: none (initial scene and goal).
+  int frames = -1;               ///< --frames N along the plan's keyframes; -1: not given.
+  std::string at;                ///< --at K1,K2,... keyframe indices of the plan; empty: none.
   std::string size = "960x720";  ///< --size WIDTHxHEIGHT [px].
   std::string camera;            ///< --camera AZ,EL[,DIST] [deg, deg, m]; empty: automatic.
   std::string backend = "egl";   ///< --backend egl|osmesa.
@@ -49,8 +68,9 @@ struct RenderArgs {
 };
 
 /// `wrap render PROJECT -o DIR`: PNGs of the initial scene and the assembled goal (and the
-/// exploded goal), a captioned contact sheet and optionally a video; exit 0, 2 bad input (bad
-/// option, unwritable folder, GL backend or ffmpeg unavailable, invalid project), 3 internal.
+/// exploded goal), or with --plan of the plan's keyframes, a captioned contact sheet and
+/// optionally a video; exit 0, 2 bad input (bad option, unwritable folder, GL backend or ffmpeg
+/// unavailable, invalid project, a plan that is malformed or for another project), 3 internal.
 int Render(const RenderArgs& args, std::ostream& out, std::ostream& err);
 
 }  // namespace wrap::cli

@@ -1,6 +1,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "render/render_job.h"
 #include "render/video.h"
 #include "sim/scene.h"
+#include "task/plan_json.h"
 
 namespace wrap::cli {
 
@@ -78,7 +80,8 @@ Result<std::vector<double>> ParseTimes(const std::string& text) {
     if (!ParseNumber(p, t)) {
       return Fail(
           ErrorCode::kInvalidInput,
-          "--at '" + text + "': expected times in seconds separated by commas, e.g. 0,2.5,10");
+          "--at '" + text +
+              "': expected keyframe indices of the plan separated by commas, e.g. 0,3,7");
     }
     times.push_back(t);
   }
@@ -111,21 +114,30 @@ int Render(const RenderArgs& args, std::ostream& out, std::ostream& err) {
                    "--explode must be a number >= 0 (a fraction of the assembly's size)"},
                   err);
   }
-  if (!args.plan.empty()) {
-    // The plan issue plugs in here: a plan timeline turns FrameTimes(duration, --frames, --at)
-    // into shots (state at t, caption "t = ... s: action"), then RunRenderJob as below.
+  const bool with_plan = !args.plan.empty();
+  if (args.frames == 0 || args.frames < -1) {
     return Report({ErrorCode::kInvalidInput,
-                   "--plan '" + args.plan +
-                       "': plans are not supported yet; without --plan, 'wrap render' draws the "
-                       "initial scene and the assembled goal"},
+                   "--frames " + std::to_string(args.frames) + ": need at least 1 frame"},
                   err);
   }
-  if (args.frames >= 0 || !at.empty()) {
-    return Report(
-        {ErrorCode::kInvalidInput,
-         "--frames and --at pick times along a plan, and need --plan (plans are not "
-         "supported yet); without a plan the render shows the initial scene and the goal"},
-        err);
+  if (!with_plan && (args.frames >= 0 || !at.empty())) {
+    return Report({ErrorCode::kInvalidInput,
+                   "--frames and --at pick keyframes along a plan, and need --plan; without a "
+                   "plan the render shows the initial scene and the goal"},
+                  err);
+  }
+  if (with_plan && (args.goal || args.explode != 0.0)) {
+    return Report({ErrorCode::kInvalidInput,
+                   "--goal and --explode draw the goal without a plan; with --plan the render "
+                   "shows the plan's keyframes (leave them out, or render the goal separately)"},
+                  err);
+  }
+  // The plan's own structure is checked before the project (and its meshes) is loaded.
+  std::optional<Plan> plan;
+  if (with_plan) {
+    auto read = ReadPlanFile(args.plan);
+    if (!read) return Report(read.error(), err);
+    plan = std::move(*read);
   }
 
   render::RenderJob job;
@@ -153,14 +165,33 @@ int Render(const RenderArgs& args, std::ostream& out, std::ostream& err) {
   auto scene = BuildCellScene(*loaded.project, loaded.check, args.project);
   if (!scene) return Report(scene.error(), err);
 
-  render::StillShotOptions still;
-  still.initial = !args.goal;
-  still.explode = args.explode;
-  auto shots = render::StillShots(*scene, still);
-  if (!shots) return Report(shots.error(), err);
-  job.shots = std::move(*shots);
-  job.title = scene->name + ": " + std::to_string(scene->robots.size()) + " robots, " +
-              std::to_string(scene->parts.size()) + " parts";
+  if (plan && !loaded.check.tree) {
+    return Report({ErrorCode::kInternal, "the project's assembly tree is missing"}, err);
+  }
+  if (plan) {
+    // A plan as a timeline of keyframes (index = time until plans are retimed).
+    if (auto ok = CheckPlanMatchesProject(*plan, *loaded.project, *loaded.check.tree, args.plan);
+        !ok) {
+      return Report(ok.error(), err);
+    }
+    render::PlanShotOptions options;
+    options.frames = args.frames;
+    options.at = at;
+    auto shots = render::PlanShots(*scene, *loaded.check.tree, *plan, options);
+    if (!shots) return Report(shots.error(), err);
+    job.shots = std::move(*shots);
+    job.title = scene->name + ": plan of " + std::to_string(plan->actions.size()) + " actions" +
+                (plan->stats.planner.empty() ? "" : " (" + plan->stats.planner + ")");
+  } else {
+    render::StillShotOptions still;
+    still.initial = !args.goal;
+    still.explode = args.explode;
+    auto shots = render::StillShots(*scene, still);
+    if (!shots) return Report(shots.error(), err);
+    job.shots = std::move(*shots);
+    job.title = scene->name + ": " + std::to_string(scene->robots.size()) + " robots, " +
+                std::to_string(scene->parts.size()) + " parts";
+  }
 
   auto report = render::RunRenderJob(*scene, job);
   if (!report) return Report(report.error(), err);

@@ -21,4 +21,9 @@ namespace wrap {
 /// - any other chain (URDF imports): the zero configuration clamped into the joint limits.
 JointVector HomeConfiguration(const Chain& chain);
 
+/// HomeConfiguration, or that with the first (revolute) joint turned by pi when the flange then
+/// comes nearer `target` in the horizontal plane (e.g. the table centre, for arms on a mobile
+/// base whose mount frames do not face the table). `X_WB` is the robot base in the world.
+JointVector FacingHomeConfiguration(const Chain& chain, const Iso3& X_WB, const Vec3& target);
+
 }  // namespace wrap

@@ -66,31 +66,6 @@ void PlacePedestal(const SceneTable& table, SceneRobot& robot) {
   robot.pedestal_bottom_z = bottom;
 }
 
-// The home configuration facing the table: HomeConfiguration, or that with the first joint
-// turned by pi when the flange then comes nearer the table centre (in the horizontal plane), e.g.
-// for arms on a mobile base, whose mount frames do not face the table.
-JointVector FacingHome(const SceneRobot& robot, const Vec3& table_center) {
-  const Chain& chain = robot.chain;
-  JointVector best = HomeConfiguration(chain);
-  if (chain.dof() == 0 || chain.joints[0].type != Joint::Type::kRevolute) return best;
-  auto distance = [&](const JointVector& q) {
-    const Vec3 d = FlangePose(chain, robot.X_WB, q).translation() - table_center;
-    return std::hypot(d.x(), d.y());
-  };
-  double best_distance = distance(best);
-  const JointVector home = best;
-  for (double turn : {std::numbers::pi, -std::numbers::pi}) {
-    JointVector q = home;
-    q[0] += turn;
-    if (!WithinLimits(chain, q)) continue;
-    if (const double d = distance(q); d < best_distance - 1e-6) {
-      best = q;
-      best_distance = d;
-    }
-  }
-  return best;
-}
-
 Result<Chain> LoadChain(const Project& project, const Robot& r, const fs::path& project_file) {
   if (!r.model.empty()) return LoadRobotModel(r.model);
   auto resolved = ResolveProjectPath(project, project_file, r.urdf);
@@ -184,7 +159,7 @@ Result<CellScene> BuildCellScene(const Project& project, const ProjectCheck& che
     robot.chain = std::move(*chain);
     robot.end_effector = std::move(*ee);
     robot.X_WB = RobotBaseInWorld(project, r);
-    robot.home = FacingHome(robot, scene.table.top_center);
+    robot.home = FacingHomeConfiguration(robot.chain, robot.X_WB, scene.table.top_center);
     robot.mounted = !r.mounted_on.empty();
     if (!robot.mounted) PlacePedestal(scene.table, robot);
     scene.robots.push_back(std::move(robot));

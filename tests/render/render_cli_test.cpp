@@ -18,7 +18,10 @@
 #include <set>
 #include <sstream>
 
+#include "model/validate.h"
 #include "render/image.h"
+#include "sim/scene.h"
+#include "task/plan_json.h"
 
 extern char** environ;
 
@@ -243,10 +246,129 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"camera", {"--camera", "10"}, "AZIMUTH,ELEVATION"},
                       BadCase{"elevation", {"--camera", "10,120"}, "elevation"},
                       BadCase{"explode", {"--explode", "-1"}, "--explode"},
-                      BadCase{"plan", {"--plan", "plan.json"}, "plans are not supported yet"},
+                      BadCase{"plan_missing", {"--plan", "no_such_plan.json"}, "no_such_plan.json"},
+                      BadCase{"plan_and_goal", {"--plan", "p.json", "--goal"}, "--goal"},
+                      BadCase{"frames_zero", {"--frames", "0"}, "at least 1 frame"},
                       BadCase{"frames", {"--frames", "5"}, "need --plan"},
                       BadCase{"at", {"--at", "0,1"}, "need --plan"}),
     [](const auto& p) { return p.param.name; });
+
+// A hand-made plan of the stool: the initial keyframe, then ur5e_a picks the seat, which is lifted
+// 5 cm while every robot stays at home (no IK: only the drawing is tested).
+fs::path WriteStoolPlan(const fs::path& dir) {
+  const LoadedProject loaded = LoadProject(Project("stool"));
+  EXPECT_TRUE(loaded.ok());
+  auto scene = BuildCellScene(*loaded.project, loaded.check, Project("stool"));
+  EXPECT_TRUE(scene.has_value());
+  const AssemblyTree& tree = *loaded.check.tree;
+  Plan plan;
+  plan.project = loaded.project->name;
+  for (const auto& r : loaded.project->robots) plan.robots.push_back(r.name);
+  for (const auto& p : loaded.project->parts) plan.parts.push_back(p.name);
+  for (const auto& n : tree.nodes) plan.nodes.push_back(n.name);
+  plan.milestone_steps = {tree.step_order.front()};
+  plan.stats.planner = "hand-made";
+  for (const SceneRobot& r : scene->robots) plan.initial.q.push_back(r.home);
+  for (size_t p = 0; p < scene->parts.size(); ++p) {
+    const ScenePart& part = scene->parts[p];
+    plan.initial.objects.push_back(
+        {static_cast<int>(p), part.X_WP_initial * part.X_AP.inverse(), true});
+  }
+  PlanAction pick;
+  pick.type = ActionType::kPick;
+  pick.robots = {0};
+  pick.objects = {0};
+  PlanHold hold;
+  hold.robot = 0;
+  hold.grasp.subassembly = 0;
+  hold.grasp.index = 3;
+  hold.grasp.part = 0;
+  hold.grasp.width_m = 0.02;
+  pick.grasps = {hold};
+  pick.milestone = 0;
+  pick.keyframe = plan.initial;
+  pick.keyframe.objects[0].X_WA.translation().z() += 0.05;
+  pick.keyframe.objects[0].resting = false;
+  plan.actions.push_back(pick);
+  fs::create_directories(dir);
+  const fs::path file = dir / "plan.json";
+  EXPECT_TRUE(SavePlan(plan, file).has_value());
+  return file;
+}
+
+TEST(RenderCli, PlanKeyframesAreDrawn) {
+  const fs::path plan = WriteStoolPlan(OutDir("plan_input"));
+  const fs::path dir = OutDir("plan");
+  ProcessRun r = RunWrap({"render", Project("stool"), "--plan", plan.string(), "-o", dir.string(),
+                          "--size", "160x120"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* f : {"plan_000_initial.png", "plan_001_pick.png", "contact_sheet.png"}) {
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+    EXPECT_NE(r.out.find(f), std::string::npos) << r.out;
+  }
+  EXPECT_FALSE(fs::exists(dir / "initial.png"));
+  EXPECT_FALSE(fs::exists(dir / "goal.png"));
+  // The seat rises and ur5e_a's fingers close: the two keyframes differ.
+  auto before = ReadPng(dir / "plan_000_initial.png");
+  auto after = ReadPng(dir / "plan_001_pick.png");
+  ASSERT_TRUE(before.has_value() && after.has_value());
+  const ImageDifference d = CompareImages(*before, *after, kTolerance);
+  ASSERT_TRUE(d.same_size);
+  EXPECT_LT(d.fraction_within, 1.0);
+  EXPECT_GT(d.max_difference, 20);
+
+  // Keyframe indices as times: --frames N evenly, --at picks keyframes.
+  const fs::path frames = OutDir("plan_frames");
+  r = RunWrap({"render", Project("stool"), "--plan", plan.string(), "-o", frames.string(),
+               "--size", "160x120", "--frames", "3"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* f : {"frame_000.png", "frame_001.png", "frame_002.png"}) {
+    EXPECT_TRUE(fs::exists(frames / f)) << f;
+  }
+  auto last = ReadPng(frames / "frame_002.png");
+  ASSERT_TRUE(last.has_value());
+  EXPECT_GE(CompareImages(*last, *after, kTolerance).fraction_within, kFractionWithin);
+  const fs::path at = OutDir("plan_at");
+  r = RunWrap({"render", Project("stool"), "--plan", plan.string(), "-o", at.string(), "--size",
+               "160x120", "--at", "1,0"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto first = ReadPng(at / "frame_000.png");
+  ASSERT_TRUE(first.has_value());
+  EXPECT_GE(CompareImages(*first, *after, kTolerance).fraction_within, kFractionWithin);
+  EXPECT_TRUE(fs::exists(at / "frame_001.png"));
+  r = RunWrap({"render", Project("stool"), "--plan", plan.string(), "-o",
+               OutDir("plan_at_bad").string(), "--at", "2"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--at"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("keyframe"), std::string::npos) << r.err;
+}
+
+TEST(RenderCli, PlanOfAnotherProjectOrMalformedExitsTwo) {
+  const fs::path plan = WriteStoolPlan(OutDir("plan_other_input"));
+  const fs::path dir = OutDir("plan_other");
+  ProcessRun r = RunWrap({"render", Project("cross"), "--plan", plan.string(), "-o", dir.string(),
+                          "--size", "160x120"});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(plan.string()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("parts[0]"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "plan_000_initial.png"));
+
+  // A keyframe with 5 joint values for a UR5e: named by file and field.
+  std::ifstream in(plan);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = "\"ur5e_b\": [";
+  const size_t pos = text.rfind(key);
+  ASSERT_NE(pos, std::string::npos);
+  const size_t comma = text.find(',', pos + key.size());
+  text.erase(pos + key.size(), comma + 1 - (pos + key.size()));
+  const fs::path broken = plan.parent_path() / "broken.json";
+  std::ofstream(broken) << text;
+  r = RunWrap({"render", Project("stool"), "--plan", broken.string(), "-o", dir.string()});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("broken.json: actions[0].keyframe.q.ur5e_b: expected 6 numbers"),
+            std::string::npos)
+      << r.err;
+}
 
 TEST(RenderCli, NoGlExitsTwoNamingWhatWasTried) {
   // glvnd's libEGL with no vendor library: no EGL display of any kind.

@@ -1,0 +1,131 @@
+#include <cstdio>
+#include <ostream>
+
+#include "cli.h"
+#include "core/run_context.h"
+#include "grasp/preprocess.h"
+#include "load.h"
+#include "task/plan_json.h"
+#include "task/plan_validator.h"
+#include "task/planner.h"
+
+namespace wrap::cli {
+
+namespace {
+
+std::string Fmt(const char* format, double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, a);
+  return buf;
+}
+
+}  // namespace
+
+int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
+  TaskPlannerOptions options;
+  options.project_file = args.project;
+  options.planner = args.planner;
+  if (args.wrench == "full") {
+    options.wrench_mode = MatingWrenchMode::kFull;
+  } else if (args.wrench == "gravity") {
+    options.wrench_mode = MatingWrenchMode::kGravityOnly;
+  } else if (args.wrench == "none") {
+    options.wrench_mode = MatingWrenchMode::kNone;
+  } else {
+    err << "--wrench: '" << args.wrench << "' is not one of full, gravity, none\n";
+    return 2;
+  }
+  if (!(args.force_scale >= 0.0) || args.force_scale > 1e6) {
+    err << "--force-scale: must be a number in [0, 1e6], got " << args.force_scale << "\n";
+    return 2;
+  }
+  options.force_scale = args.force_scale;
+  if (args.time_limit && !(*args.time_limit > 0.0)) {
+    err << "--time-limit: must be positive seconds\n";
+    return 2;
+  }
+
+  const LoadedProject loaded = LoadChecked(args.project);
+  const Diagnostics& diags = loaded.check.diagnostics;
+  for (const Diagnostic& d : diags.items) err << Format(d) << "\n";
+  if (!loaded.ok()) {
+    err << args.project << ": invalid: " << diags.error_count()
+        << " error(s); run 'wrap validate'\n";
+    return 2;
+  }
+  const Project& p = *loaded.project;
+  const std::uint64_t seed = args.seed.value_or(p.planner.seed);
+  const double time_limit = args.time_limit.value_or(p.planner.time_limit_s);
+  RunContext ctx(seed);
+  ctx.set_time_limit_s(time_limit);
+
+  out << "Planning '" << p.name << "' (" << options.planner << ", seed " << seed << ", wrench "
+      << args.wrench << ", lambda " << Fmt("%g", options.force_scale) << ", time limit "
+      << Fmt("%g", time_limit) << " s)\n";
+  PreprocessOptions pre_options;
+  pre_options.project_file = args.project;
+  pre_options.grasps = args.grasps;
+  auto pre = wrap::Preprocess(p, loaded.check, pre_options, ctx);
+  if (!pre) {
+    err << args.project << ": " << pre.error().message << "\n";
+    if (pre.error().code == ErrorCode::kTimeout) {
+      err << "no plan: the time limit ran out during preprocessing\n";
+      return 1;
+    }
+    return ExitCodeFor(pre.error().code);
+  }
+  for (const std::string& w : pre->warnings) err << args.project << ": warning: " << w << "\n";
+  auto plan = PlanTask(p, loaded.check, *pre, options, ctx);
+  if (!plan) {
+    err << args.project << ": " << plan.error().message << "\n";
+    return ExitCodeFor(plan.error().code);
+  }
+  plan->stats.seed = seed;
+  const PlanStats& st = plan->stats;
+  out << "Preprocessing (t_grasp) " << Fmt("%.2f", st.t_grasp_s) << " s\n";
+  if (st.solved) {
+    out << "Solved: cost " << st.cost << ", time to first plan " << Fmt("%.2f", st.t_init_s)
+        << " s (t_fwd " << Fmt("%.2f", st.t_fwd_s) << ", t_ik " << Fmt("%.2f", st.t_ik_s)
+        << ", t_lp " << Fmt("%.2f", st.t_lp_s) << "; " << st.expansions << " nodes, "
+        << st.validations << " edges validated, " << st.validation_failures << " failed)\n";
+    for (size_t i = 0; i < plan->actions.size(); ++i) {
+      out << "  " << (i + 1) << ". " << DescribeAction(*plan, plan->actions[i]) << "\n";
+    }
+    if (!args.task_only) {
+      out << "(motion planning is not part of this build yet: the plan holds keyframes)\n";
+    }
+  } else {
+    err << "No plan found in " << Fmt("%.1f", st.t_init_s) << " s: " << st.failure << "\n";
+  }
+
+  if (!args.output.empty()) {
+    if (auto saved = SavePlan(*plan, args.output); !saved) {
+      err << args.output << ": " << saved.error().message << "\n";
+      return ExitCodeFor(saved.error().code);
+    }
+    out << "Wrote " << args.output << "\n";
+  }
+  if (!st.solved) return 1;
+
+  if (args.validate) {
+    PlanValidationOptions vopt;
+    vopt.wrench_mode = options.wrench_mode;
+    vopt.force_scale = options.force_scale;
+    auto v = ValidatePlan(p, loaded.check, *plan, vopt, args.project);
+    if (!v) {
+      err << "validation: " << v.error().message << "\n";
+      return ExitCodeFor(v.error().code);
+    }
+    if (!v->valid) {
+      err << "Validation FAILED: " << v->issues.size() << " issue(s)\n";
+      for (const PlanIssue& issue : v->issues) err << "  " << FormatIssue(issue) << "\n";
+      return 1;
+    }
+    out << "Validated: " << v->actions << " actions, " << v->keyframes << " keyframes, "
+        << v->collision_checks << " collision queries, " << v->wrench_checks
+        << " wrench gates re-solved\n";
+  }
+  return 0;
+}
+
+}  // namespace wrap::cli

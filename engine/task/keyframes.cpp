@@ -1,0 +1,709 @@
+#include "task/keyframes.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <numbers>
+
+#include "robot/kinematics.h"
+
+namespace wrap {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+// Rotation taking unit vector a onto unit vector b.
+Mat3 RotationBetween(const Vec3& a, const Vec3& b) {
+  return Eigen::Quaterniond::FromTwoVectors(a, b).toRotationMatrix();
+}
+
+Mat3 RandomRotation(std::mt19937_64& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
+  q.normalize();
+  return q.toRotationMatrix();
+}
+
+// Candidates tried per effort level for poses in the air.
+constexpr int kAirSamples[] = {6, 16, 40};
+constexpr int kAssemblySamples[] = {10, 25, 60};
+constexpr int kNumericRestarts[] = {3, 10, 25};
+constexpr int kMaxLeaves = 24;           // IK combinations tried per pose candidate
+constexpr int kMaxSolutionsPerRobot = 8;
+
+}  // namespace
+
+std::string_view GateName(Gate gate) {
+  switch (gate) {
+    case Gate::kNone: return "none";
+    case Gate::kReach: return "out of reach";
+    case Gate::kIk: return "IK";
+    case Gate::kCollision: return "collision";
+    case Gate::kClearance: return "robot clearance";
+    case Gate::kApproach: return "insertion approach";
+    case Gate::kTable: return "below the table";
+    case Gate::kWrenchAssembly: return "wrench (assembly)";
+    case Gate::kWrenchTransport: return "wrench (transport)";
+    case Gate::kWrenchRelease: return "wrench (release)";
+    case Gate::kWrenchRest: return "wrench (rest)";
+  }
+  return "?";
+}
+
+KeyframeSolver::KeyframeSolver(const TaskWorld& world, TaskTables& tables,
+                               const TaskPlannerOptions& options, Cell cell,
+                               TaskCounters& counters)
+    : world_(world),
+      tables_(tables),
+      options_(options),
+      cell_(std::move(cell)),
+      counters_(counters),
+      checker_(WrenchOptions{}) {
+  frames_.resize(world.robots.size());
+  for (size_t r = 0; r < world.robots.size(); ++r) {
+    frames_[r].resize(world.robots[r].chain.links.size());
+  }
+  part_object_.assign(world.num_parts, -1);
+}
+
+Iso3 KeyframeSolver::GraspTarget(const Iso3& X_WA, int grasp_id) const {
+  const GraspRef& g = tables_.grasp(grasp_id);
+  return X_WA * world_.X_AP[g.part] * g.X_PG;
+}
+
+bool KeyframeSolver::InReach(int robot, const Iso3& X_WT) const {
+  const TaskRobot& r = world_.robots[robot];
+  return (X_WT.translation() - r.shoulder_W).norm() <= r.reach_m;
+}
+
+bool KeyframeSolver::ClearOfTable(int robot, const Iso3& X_WT) {
+  const TaskRobot& r = world_.robots[robot];
+  const Iso3 X_WF = X_WT * r.end_effector.X_FT.inverse();
+  CollisionWorld& w = cell_.world();
+  const BodyId ee = cell_.end_effector_body(robot);
+  const Iso3 saved = w.pose(ee);
+  w.SetPose(ee, X_WF);
+  const bool hit = w.Collide(ee, cell_.table_body());
+  w.SetPose(ee, saved);
+  return !hit;
+}
+
+bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objects,
+                            int mating_step, std::uint64_t key, std::string* reason) {
+  if (options_.wrench_mode == MatingWrenchMode::kNone) return true;
+  ++counters_.lp_checks;
+  const auto start = Clock::now();
+  const StepConfiguration config = BuildWrenchConfig(world_, tables_, objects, mating_step);
+  WrenchQuery query;
+  query.gate = gate;
+  query.mode = options_.wrench_mode;
+  query.lambda = options_.force_scale;
+  auto result = key != 0 ? checker_.CheckCached(key, config, query)
+                         : checker_.CheckCached(config, query);
+  counters_.t_lp_s += Seconds(start);
+  if (!result) {
+    if (reason) *reason = result.error().message;
+    return false;
+  }
+  if (!result->feasible && reason) *reason = result->reason;
+  return result->feasible;
+}
+
+std::vector<Mat3> KeyframeSolver::AxisOrientations(const Vec3& axis_A) {
+  std::vector<Mat3> out;
+  const Vec3 dirs[] = {-Vec3::UnitZ(), Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(),
+                       -Vec3::UnitY(), Vec3::UnitZ()};
+  for (const Vec3& d : dirs) {
+    const Mat3 align = RotationBetween(axis_A.normalized(), d);
+    for (int k = 0; k < 4; ++k) {
+      out.push_back(Eigen::AngleAxisd(k * std::numbers::pi / 2, d).toRotationMatrix() * align);
+    }
+  }
+  return out;
+}
+
+bool KeyframeSolver::AirAssemblyPossible(int step,
+                                         const std::vector<std::pair<int, int>>& moved_holders,
+                                         const std::vector<std::pair<int, int>>& base_holders,
+                                         std::uint64_t key, std::string* reason) {
+  const StepInterface& s = world_.interface(step);
+  const std::vector<Mat3> orientations = AxisOrientations(s.axis_A);
+  for (size_t k = 0; k < orientations.size(); ++k) {
+    Iso3 X = Iso3::Identity();
+    X.linear() = orientations[k];
+    X.translation() = Vec3(0, 0, world_.table_top + 0.3);
+    const WrenchObject objs[2] = {{s.moved, X, false, moved_holders},
+                                  {s.base, X, false, base_holders}};
+    if (Wrench(WrenchGate::kAssembly, objs, step, HashMix(key, k + 1), reason)) return true;
+  }
+  return false;
+}
+
+bool KeyframeSolver::SolveIk(int robot, const Iso3& X_WT, const JointVector& reference, int effort,
+                             std::mt19937_64& rng, std::vector<JointVector>& out) {
+  out.clear();
+  ++counters_.ik_calls;
+  if (!InReach(robot, X_WT)) return false;
+  const TaskRobot& r = world_.robots[robot];
+  const Iso3 X_BT = r.X_BW * X_WT;
+  if (r.ur) {
+    const UrIkSolutions sols = r.ur->SolveTcp(X_BT, r.end_effector.X_FT);
+    for (int i = 0; i < sols.count; ++i) {
+      out.push_back(NearestEquivalent(r.chain, sols.q[i], reference));
+    }
+  } else {
+    NumericIkRequest request;
+    request.X_BT = X_BT;
+    request.X_FT = r.end_effector.X_FT;
+    request.seeds = {reference, r.home};
+    request.reference = reference;
+    NumericIkOptions o;
+    o.restarts = kNumericRestarts[std::clamp(effort, 0, 2)];
+    o.all_branches = effort > 0;
+    o.position_tolerance_m = 1e-4;
+    o.rotation_tolerance_rad = 1e-3;
+    auto result = SolveNumericIk(r.chain, request, rng, o);
+    if (result) out = result->branches;
+  }
+  std::stable_sort(out.begin(), out.end(), [&](const JointVector& a, const JointVector& b) {
+    return (a - reference).squaredNorm() < (b - reference).squaredNorm();
+  });
+  if (out.size() > kMaxSolutionsPerRobot) out.resize(kMaxSolutionsPerRobot);
+  return !out.empty();
+}
+
+void KeyframeSolver::SetRobot(int robot, const JointVector& q) {
+  ForwardKinematics(world_.robots[robot].chain, world_.robots[robot].X_WB, q, frames_[robot]);
+  cell_.SetConfiguration(robot, std::span<const double>(q.data(), q.size()), frames_[robot]);
+}
+
+void KeyframeSolver::EnableRobot(int robot, bool on) {
+  CollisionWorld& w = cell_.world();
+  const int links = static_cast<int>(world_.robots[robot].chain.links.size());
+  for (int i = 0; i < links; ++i) w.SetEnabled(cell_.link_body(robot, i), on);
+  w.SetEnabled(cell_.end_effector_body(robot), on);
+}
+
+bool KeyframeSolver::Collides() {
+  ++counters_.collision_checks;
+  return cell_.InCollision();
+}
+
+void KeyframeSolver::SetScene(const std::vector<PlanObject>& objects,
+                              const std::vector<std::pair<int, int>>& holds, int allow_a,
+                              int allow_b) {
+  CollisionWorld& w = cell_.world();
+  std::fill(part_object_.begin(), part_object_.end(), -1);
+  for (size_t i = 0; i < objects.size(); ++i) {
+    for (int p : world_.tree->nodes[objects[i].node].parts) {
+      part_object_[p] = static_cast<int>(i);
+      cell_.SetObjectPose(p, objects[i].X_WA * world_.X_AP[p]);
+    }
+  }
+  const BodyId table = cell_.table_body();
+  for (int p = 0; p < world_.num_parts; ++p) {
+    const BodyId body = cell_.object_body(p);
+    const int op = part_object_[p];
+    w.SetEnabled(body, op >= 0);
+    if (op < 0) continue;
+    w.SetAllowed(body, table, objects[op].resting);
+    for (int q = p + 1; q < world_.num_parts; ++q) {
+      const int oq = part_object_[q];
+      if (oq < 0) continue;
+      const int na = objects[op].node, nb = objects[oq].node;
+      const bool mated = (na == allow_a && nb == allow_b) || (na == allow_b && nb == allow_a);
+      w.SetAllowed(body, cell_.object_body(q), op == oq || mated);
+    }
+    for (int r = 0; r < static_cast<int>(world_.robots.size()); ++r) {
+      w.SetAllowed(cell_.end_effector_body(r), body, false);
+    }
+  }
+  for (const auto& [robot, grasp] : holds) {
+    w.SetAllowed(cell_.end_effector_body(robot), cell_.object_body(tables_.grasp(grasp).part),
+                 true);
+  }
+}
+
+bool KeyframeSolver::Search(const std::vector<Mover>& movers,
+                            const std::vector<std::vector<JointVector>>& sols, size_t depth,
+                            std::vector<JointVector>& chosen, int& leaves, Gate& gate,
+                            const std::function<bool(std::vector<JointVector>&)>& leaf) {
+  if (depth == movers.size()) {
+    ++leaves;
+    return leaf(chosen);
+  }
+  const int r = movers[depth].robot;
+  EnableRobot(r, true);
+  for (const JointVector& q : sols[depth]) {
+    SetRobot(r, q);
+    if (Collides()) {
+      if (gate == Gate::kNone || gate == Gate::kIk) gate = Gate::kCollision;
+      continue;
+    }
+    chosen[depth] = q;
+    if (Search(movers, sols, depth + 1, chosen, leaves, gate, leaf)) return true;
+    if (leaves >= kMaxLeaves) break;
+  }
+  EnableRobot(r, false);
+  return false;
+}
+
+EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, const TaskAction& a,
+                                     const SymState& next, int effort, std::uint64_t seed) {
+  ++counters_.validations;
+  const auto start = Clock::now();
+  const double lp_before = counters_.t_lp_s;
+  std::mt19937_64 rng(HashMix(seed, static_cast<std::uint64_t>(effort) + 11));
+  effort = std::clamp(effort, 0, 2);
+  const int n_robots = static_cast<int>(world_.robots.size());
+
+  auto holders_of = [&](const SymState& st, int node) {
+    std::vector<std::pair<int, int>> h;
+    for (int r = 0; r < n_robots; ++r) {
+      if (st.held[r] == node) h.push_back({r, st.grasp[r]});
+    }
+    return h;
+  };
+  // Workspace centre of some robots: their shoulders' mean, pulled toward the table centre.
+  auto workspace_centre = [&](const std::vector<int>& robots) {
+    Vec3 m = Vec3::Zero();
+    for (int r : robots) m += world_.robots[r].shoulder_W;
+    m /= std::max<size_t>(1, robots.size());
+    Vec3 p = m + 0.4 * (world_.table_center - m);
+    p.z() = world_.table_top + 0.28;
+    return p;
+  };
+
+  // The problem, filled per action type.
+  std::vector<Mover> movers;
+  std::vector<int> reposed;         // nodes whose pose is sampled
+  int n_candidates = 1;
+  std::function<bool(int, std::vector<Iso3>&)> make;  // candidate poses (node-indexed)
+  std::function<bool(const std::vector<Iso3>&, Gate&, std::string&)> gates;
+  std::vector<int> keyframe_nodes;  // objects listed in the keyframe
+  std::vector<bool> keyframe_resting(world_.num_nodes, false);
+  int allow_a = -1, allow_b = -1;   // mated pair at the keyframe (assemble)
+  std::vector<int> freed;           // robots that go home after the action
+  std::vector<std::pair<int, int>> holds_at_keyframe;
+  for (int r = 0; r < n_robots; ++r) {
+    if (s.held[r] >= 0) holds_at_keyframe.push_back({r, s.grasp[r]});
+  }
+  for (int node = 0; node < world_.num_nodes; ++node) {
+    if (s.loc[node] != kInactive) {
+      keyframe_nodes.push_back(node);
+      keyframe_resting[node] = s.loc[node] >= 0;
+    }
+  }
+  const bool fixed_ik_complete = true;  // UR closed form: all solutions
+  bool numeric = false;
+  auto add_mover = [&](int robot, int node, int grasp) {
+    movers.push_back({robot, node, grasp});
+    if (!world_.robots[robot].ur) numeric = true;
+  };
+  // Random pose of `node` around `centre`, orientation R.
+  auto air_pose = [&](int node, const Mat3& R, const Vec3& centre, bool jitter) {
+    Vec3 p = centre;
+    if (jitter) {
+      std::uniform_real_distribution<double> u(-1.0, 1.0);
+      p += Vec3(0.08 * u(rng), 0.08 * u(rng), 0.06 + 0.08 * u(rng));
+    }
+    Iso3 X = Iso3::Identity();
+    X.linear() = R;
+    X.translation() = p - R * world_.pre->subassemblies[node].com_A;
+    return X;
+  };
+  auto above_table = [&](int node, const Iso3& X) {
+    return LowestPoint(world_, node, X) >= world_.table_top + 0.01;
+  };
+
+  const int o = a.obj;
+  switch (a.type) {
+    case ActionType::kPick: {
+      add_mover(a.r1, o, a.grasp);
+      holds_at_keyframe.push_back({a.r1, a.grasp});
+      make = [&](int, std::vector<Iso3>&) { return true; };
+      gates = [&](const std::vector<Iso3>& X, Gate& g, std::string& why) {
+        const WrenchObject obj{o, X[o], false, {{a.r1, a.grasp}}};
+        const std::uint64_t key =
+            HashMix(HashMix(HashMix(1, static_cast<std::uint64_t>(s.loc[o]) + 100), a.r1),
+                    static_cast<std::uint64_t>(a.grasp));
+        if (!Wrench(WrenchGate::kTransport, {&obj, 1}, -1, key, &why)) {
+          g = Gate::kWrenchTransport;
+          return false;
+        }
+        return true;
+      };
+      break;
+    }
+    case ActionType::kPlace: {
+      add_mover(a.r1, o, s.grasp[a.r1]);
+      keyframe_resting[o] = true;
+      freed.push_back(a.r1);
+      make = [&](int, std::vector<Iso3>& X) {
+        X[o] = tables_.location(a.loc).X_WA;
+        return true;
+      };
+      gates = [&](const std::vector<Iso3>& X, Gate& g, std::string& why) {
+        const WrenchObject obj{o, X[o], true, {}};
+        if (!Wrench(WrenchGate::kRest, {&obj, 1}, -1, HashMix(2, a.loc + 1), &why)) {
+          g = Gate::kWrenchRest;
+          return false;
+        }
+        return true;
+      };
+      break;
+    }
+    case ActionType::kHandover: {
+      add_mover(a.r1, o, s.grasp[a.r1]);
+      add_mover(a.r2, o, a.grasp);
+      holds_at_keyframe.push_back({a.r2, a.grasp});
+      freed.push_back(a.r1);
+      reposed.push_back(o);
+      n_candidates = kAirSamples[effort];
+      const Vec3 centre = workspace_centre({a.r1, a.r2});
+      make = [&, centre](int k, std::vector<Iso3>& X) {
+        const Mat3 R = k < n_candidates / 3 ? Mat3(c.X_WA[o].linear()) : RandomRotation(rng);
+        X[o] = air_pose(o, R, centre, k > 0);
+        return above_table(o, X[o]);
+      };
+      gates = [&](const std::vector<Iso3>& X, Gate& g, std::string& why) {
+        const WrenchObject obj{o, X[o], false, {{a.r2, a.grasp}}};
+        if (!Wrench(WrenchGate::kTransport, {&obj, 1}, -1, 0, &why)) {
+          g = Gate::kWrenchTransport;
+          return false;
+        }
+        return true;
+      };
+      break;
+    }
+    case ActionType::kAddGrasp: {
+      const auto holders = holders_of(s, o);
+      const bool resting = s.loc[o] >= 0;
+      if (!resting) {
+        for (const auto& [r, g] : holders) add_mover(r, o, g);
+        reposed.push_back(o);
+      }
+      add_mover(a.r1, o, a.grasp);
+      holds_at_keyframe.push_back({a.r1, a.grasp});
+      std::vector<int> robots;
+      for (const Mover& m : movers) robots.push_back(m.robot);
+      const Vec3 centre = workspace_centre(robots);
+      n_candidates = resting ? 1 : kAirSamples[effort];
+      make = [&, centre, resting](int k, std::vector<Iso3>& X) {
+        if (resting || k == 0) return true;
+        const Mat3 R = k < n_candidates / 2 ? Mat3(c.X_WA[o].linear()) : RandomRotation(rng);
+        X[o] = air_pose(o, R, centre, true);
+        return above_table(o, X[o]);
+      };
+      gates = [&, holders, resting](const std::vector<Iso3>& X, Gate& g, std::string& why) {
+        WrenchObject obj{o, X[o], resting, holders};
+        obj.holders.push_back({a.r1, a.grasp});
+        if (!Wrench(WrenchGate::kRelease, {&obj, 1}, -1, 0, &why)) {
+          g = Gate::kWrenchRelease;
+          return false;
+        }
+        return true;
+      };
+      break;
+    }
+    case ActionType::kRelease: {
+      freed.push_back(a.r1);
+      make = [&](int, std::vector<Iso3>&) { return true; };
+      gates = [&](const std::vector<Iso3>& X, Gate& g, std::string& why) {
+        auto remaining = holders_of(next, o);
+        const bool resting = s.loc[o] >= 0;
+        const WrenchObject obj{o, X[o], resting, remaining};
+        const WrenchGate gate = remaining.empty() ? WrenchGate::kRest : WrenchGate::kRelease;
+        if (!Wrench(gate, {&obj, 1}, -1, 0, &why)) {
+          g = remaining.empty() ? Gate::kWrenchRest : Gate::kWrenchRelease;
+          return false;
+        }
+        return true;
+      };
+      break;
+    }
+    case ActionType::kAssemble: {
+      const StepInterface& st = world_.interface(o);
+      const int M = st.moved, B = st.base;
+      const auto m_holders = holders_of(s, M);
+      const auto b_holders = holders_of(s, B);
+      const bool b_rests = s.loc[B] >= 0;
+      for (const auto& [r, g] : m_holders) add_mover(r, M, g);
+      std::vector<int> robots;
+      for (const auto& [r, g] : m_holders) robots.push_back(r);
+      if (!b_rests) {
+        for (const auto& [r, g] : b_holders) {
+          add_mover(r, B, g);
+          robots.push_back(r);
+        }
+        reposed.push_back(B);
+        n_candidates = kAssemblySamples[effort];
+      }
+      allow_a = M;
+      allow_b = B;
+      const Vec3 centre = workspace_centre(robots);
+      auto orientations = std::make_shared<std::vector<Mat3>>(AxisOrientations(st.axis_A));
+      make = [&, centre, orientations, b_rests, M, B](int k, std::vector<Iso3>& X) {
+        if (!b_rests) {
+          Mat3 R;
+          if (k == 0) {
+            R = c.X_WA[B].linear();
+          } else if (k <= static_cast<int>(orientations->size())) {
+            R = (*orientations)[k - 1];
+          } else {
+            R = (*orientations)[rng() % orientations->size()];
+          }
+          X[B] = air_pose(B, R, centre, k > static_cast<int>(orientations->size()));
+        }
+        X[M] = X[B];
+        if (!b_rests && !above_table(B, X[B])) return false;
+        // The moved input must not reach under the table top.
+        return LowestPoint(world_, M, X[M]) >= world_.table_top - 1e-3;
+      };
+      gates = [&, m_holders, b_holders, b_rests, M, B](const std::vector<Iso3>& X, Gate& g,
+                                                       std::string& why) {
+        const WrenchObject objs[2] = {{M, X[M], false, m_holders}, {B, X[B], b_rests, b_holders}};
+        std::uint64_t key = 0;
+        if (b_rests) {
+          key = HashMix(3, static_cast<std::uint64_t>(o));
+          key = HashMix(key, static_cast<std::uint64_t>(s.loc[B]) + 7);
+          for (const auto& [r, gr] : m_holders) key = HashMix(HashMix(key, r), gr);
+          key = HashMix(key, 999);
+          for (const auto& [r, gr] : b_holders) key = HashMix(HashMix(key, r), gr);
+        }
+        if (!Wrench(WrenchGate::kAssembly, objs, o, key, &why)) {
+          g = Gate::kWrenchAssembly;
+          return false;
+        }
+        return true;
+      };
+      break;
+    }
+  }
+
+  std::vector<Iso3> X = c.X_WA;
+  EdgeOutcome out;
+  Gate worst = Gate::kNone;
+  std::string why;
+  auto note = [&](Gate g, const std::string& message) {
+    // Keep the most advanced failure: wrench < IK < collision < clearance < approach.
+    auto rank = [](Gate x) {
+      switch (x) {
+        case Gate::kNone: return 0;
+        case Gate::kTable: return 1;
+        case Gate::kWrenchTransport:
+        case Gate::kWrenchRelease:
+        case Gate::kWrenchRest:
+        case Gate::kWrenchAssembly: return 2;
+        case Gate::kReach: return 3;
+        case Gate::kIk: return 4;
+        case Gate::kCollision: return 5;
+        case Gate::kClearance: return 6;
+        case Gate::kApproach: return 7;
+      }
+      return 0;
+    };
+    if (rank(g) >= rank(worst)) {
+      worst = g;
+      why = message;
+    }
+  };
+
+  for (int r = 0; r < n_robots; ++r) {
+    EnableRobot(r, true);
+    SetRobot(r, c.q[r]);
+  }
+  bool success = false;
+  std::vector<JointVector> chosen(movers.size());
+  std::optional<Keyframe> approach;
+  for (int k = 0; k < n_candidates && !success; ++k) {
+    X = c.X_WA;
+    if (!make(k, X)) {
+      note(Gate::kTable, "the object would be below the table top");
+      continue;
+    }
+    Gate g = Gate::kNone;
+    std::string message;
+    if (!gates(X, g, message)) {
+      note(g, message);
+      continue;
+    }
+    if (movers.empty() && freed.empty()) {
+      success = true;
+      break;
+    }
+    // IK of every mover.
+    std::vector<std::vector<JointVector>> sols(movers.size());
+    bool all = true;
+    for (size_t i = 0; i < movers.size() && all; ++i) {
+      const Mover& m = movers[i];
+      const Iso3 target = GraspTarget(X[m.node], m.grasp);
+      if (!InReach(m.robot, target)) {
+        note(Gate::kReach, "'" + world_.robots[m.robot].name + "' cannot reach grasp " +
+                               std::to_string(tables_.grasp(m.grasp).index) + " there");
+        all = false;
+        break;
+      }
+      if (!ClearOfTable(m.robot, target)) {
+        note(Gate::kCollision, "the gripper of '" + world_.robots[m.robot].name +
+                                   "' would be in the table at grasp " +
+                                   std::to_string(tables_.grasp(m.grasp).index));
+        all = false;
+        break;
+      }
+      if (!SolveIk(m.robot, target, c.q[m.robot], effort, rng, sols[i])) {
+        note(Gate::kIk, "no IK solution for '" + world_.robots[m.robot].name + "' at grasp " +
+                            std::to_string(tables_.grasp(m.grasp).index));
+        all = false;
+      }
+    }
+    if (!all) continue;
+    // Scene at the keyframe.
+    std::vector<PlanObject> objects;
+    for (int node : keyframe_nodes) objects.push_back({node, X[node], keyframe_resting[node]});
+    SetScene(objects, holds_at_keyframe, allow_a, allow_b);
+    for (const Mover& m : movers) EnableRobot(m.robot, false);
+    int leaves = 0;
+    Gate search_gate = Gate::kNone;
+    std::string leaf_message;
+    auto leaf = [&](std::vector<JointVector>& q) {
+      if (n_robots >= 2) {
+        DistanceRequest request;
+        request.upper_bound_m = options_.min_clearance_m * 2 + 0.01;
+        const DistanceResult d = cell_.MinRobotClearance(request);
+        if (d.distance < options_.min_clearance_m) {
+          search_gate = Gate::kClearance;
+          leaf_message = "robots closer than " +
+                         std::to_string(options_.min_clearance_m * 1000).substr(0, 4) + " mm";
+          return false;
+        }
+      }
+      if (!freed.empty()) {
+        // The robots this action frees go home: that must be clear of everything that stays.
+        std::vector<std::pair<int, int>> holds_after;
+        for (const auto& h : holds_at_keyframe) {
+          if (std::find(freed.begin(), freed.end(), h.first) == freed.end()) holds_after.push_back(h);
+        }
+        SetScene(objects, holds_after, allow_a, allow_b);
+        for (int r : freed) SetRobot(r, world_.robots[r].home);
+        for (size_t i = 0; i < movers.size(); ++i) {
+          if (std::find(freed.begin(), freed.end(), movers[i].robot) == freed.end()) {
+            SetRobot(movers[i].robot, q[i]);
+          }
+        }
+        const bool hit = Collides();
+        SetScene(objects, holds_at_keyframe, allow_a, allow_b);
+        for (size_t i = 0; i < movers.size(); ++i) SetRobot(movers[i].robot, q[i]);
+        if (!movers.empty()) {
+          for (int r : freed) {
+            if (std::find_if(movers.begin(), movers.end(),
+                             [r](const Mover& m) { return m.robot == r; }) == movers.end()) {
+              SetRobot(r, c.q[r]);
+            }
+          }
+        } else {
+          for (int r : freed) SetRobot(r, c.q[r]);
+        }
+        if (hit) {
+          search_gate = Gate::kCollision;
+          leaf_message = "'" + world_.robots[freed.front()].name +
+                         "' cannot go home afterwards without a collision";
+          return false;
+        }
+      }
+      if (a.type != ActionType::kAssemble) return true;
+      // The insertion: the moved input `approach_m` back along the axis, reachable near the
+      // mated joints, and collision-free without the mated contact.
+      const StepInterface& st = world_.interface(o);
+      const Vec3 axis_W = X[st.base].linear() * st.axis_A;
+      std::vector<Iso3> Xa = X;
+      Xa[st.moved].translation() -= st.approach_m * axis_W;
+      std::vector<JointVector> qa = q;
+      for (size_t i = 0; i < movers.size(); ++i) {
+        if (movers[i].node != st.moved) continue;
+        const int r = movers[i].robot;
+        // Halfway and at the approach: the nearest solution must stay on the same branch.
+        JointVector ref = q[i];
+        for (double f : {0.5, 1.0}) {
+          std::vector<Iso3> Xf = X;
+          Xf[st.moved].translation() -= f * st.approach_m * axis_W;
+          std::vector<JointVector> s2;
+          if (!SolveIk(r, GraspTarget(Xf[st.moved], movers[i].grasp), ref, effort, rng, s2) ||
+              JointDistanceMax(world_.robots[r].chain, s2.front(), ref, false) > 0.5) {
+            search_gate = Gate::kApproach;
+            leaf_message = "'" + world_.robots[r].name +
+                           "' cannot make the straight insertion from the approach pose";
+            return false;
+          }
+          ref = s2.front();
+        }
+        qa[i] = ref;
+      }
+      std::vector<PlanObject> objs_a;
+      for (int node : keyframe_nodes) objs_a.push_back({node, Xa[node], keyframe_resting[node]});
+      SetScene(objs_a, holds_at_keyframe, -1, -1);
+      for (size_t i = 0; i < movers.size(); ++i) SetRobot(movers[i].robot, qa[i]);
+      const bool hit = Collides();
+      // Restore the mated scene for the search to go on.
+      SetScene(objects, holds_at_keyframe, allow_a, allow_b);
+      for (size_t i = 0; i < movers.size(); ++i) SetRobot(movers[i].robot, q[i]);
+      if (hit) {
+        search_gate = Gate::kApproach;
+        leaf_message = "the insertion approach collides";
+        return false;
+      }
+      Keyframe kf;
+      kf.q = c.q;
+      for (size_t i = 0; i < movers.size(); ++i) kf.q[movers[i].robot] = qa[i];
+      kf.objects = std::move(objs_a);
+      approach = std::move(kf);
+      return true;
+    };
+    if (Search(movers, sols, 0, chosen, leaves, search_gate, leaf)) {
+      success = true;
+      break;
+    }
+    for (const Mover& m : movers) EnableRobot(m.robot, true);
+    std::string who;
+    for (const Mover& m : movers) who += (who.empty() ? "'" : ", '") + world_.robots[m.robot].name + "'";
+    note(search_gate == Gate::kNone ? Gate::kCollision : search_gate,
+         leaf_message.empty() ? "every IK solution of " + who + " collides" : leaf_message);
+  }
+  for (int r = 0; r < n_robots; ++r) EnableRobot(r, true);
+  counters_.t_ik_s += Seconds(start) - (counters_.t_lp_s - lp_before);
+
+  if (!success) {
+    ++counters_.validation_failures;
+    out.ok = false;
+    out.gate = worst;
+    out.message = why;
+    // Closed-form IK at a fixed pose (nothing sampled) or a wrench failure: effort cannot help.
+    const bool wrench_only = worst == Gate::kWrenchAssembly || worst == Gate::kWrenchRest ||
+                             worst == Gate::kWrenchRelease ||
+                             (worst == Gate::kWrenchTransport && reposed.empty());
+    out.permanent = wrench_only || (reposed.empty() && !numeric && fixed_ik_complete);
+    return out;
+  }
+  out.ok = true;
+  ContState& nc = out.next;
+  nc.q = c.q;
+  for (size_t i = 0; i < movers.size(); ++i) nc.q[movers[i].robot] = chosen[i];
+  nc.X_WA = X;
+  Keyframe& kf = out.keyframe;
+  kf.q = nc.q;
+  for (int node : keyframe_nodes) kf.objects.push_back({node, X[node], keyframe_resting[node]});
+  for (int r : freed) nc.q[r] = world_.robots[r].home;
+  if (a.type == ActionType::kAssemble) {
+    const StepInterface& st = world_.interface(o);
+    nc.X_WA[o] = X[st.base];
+    out.approach = std::move(approach);
+  }
+  return out;
+}
+
+}  // namespace wrap

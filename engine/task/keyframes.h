@@ -1,0 +1,123 @@
+// Edge validation of the task search (paper Alg. 2, ValidateIK): turns one symbolic action from a
+// continuous state into a keyframe where every acting robot reaches its grasp (IK), nothing
+// collides, the robots keep their minimum clearance and the wrench gates hold; or says which gate
+// failed. Also the cheap checks the search makes while expanding (reach, gripper vs table, LPs
+// whose poses are fixed).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <random>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "robot/cell.h"
+#include "task/planner.h"
+#include "task/state.h"
+#include "task/world.h"
+#include "task/wrench_model.h"
+#include "wrench/wrench.h"
+
+namespace wrap {
+
+/// Which check rejected an edge.
+enum class Gate {
+  kNone,
+  kReach,
+  kIk,
+  kCollision,
+  kClearance,
+  kApproach,
+  kTable,
+  kWrenchAssembly,
+  kWrenchTransport,
+  kWrenchRelease,
+  kWrenchRest,
+};
+/// Words for a gate, e.g. "IK", "collision", "wrench (assembly)".
+std::string_view GateName(Gate gate);
+inline constexpr int kNumGates = 11;
+
+/// Counters and times of the checks.
+struct TaskCounters {
+  long long validations = 0;
+  long long validation_failures = 0;
+  long long lp_checks = 0;
+  long long ik_calls = 0;
+  long long collision_checks = 0;
+  double t_ik_s = 0.0;
+  double t_lp_s = 0.0;
+};
+
+/// What validating an edge gave.
+struct EdgeOutcome {
+  bool ok = false;
+  bool permanent = false;    ///< Failed for a reason more effort cannot change.
+  Gate gate = Gate::kNone;   ///< The gate that failed (most informative candidate).
+  std::string message;       ///< Why, in words.
+  Keyframe keyframe;         ///< The keyframe (ok only).
+  std::optional<Keyframe> approach;
+  ContState next;            ///< Continuous state after the action (ok only).
+};
+
+/// Validates edges and answers the cheap checks. Holds a copy of the cell: one per thread.
+class KeyframeSolver {
+ public:
+  KeyframeSolver(const TaskWorld& world, TaskTables& tables, const TaskPlannerOptions& options,
+                 Cell cell, TaskCounters& counters);
+
+  /// Validates `a` from (s, c) at effort level `effort` (0-based); `next` is the symbolic state
+  /// after it. `seed` makes the pose sampling deterministic.
+  EdgeOutcome Validate(const SymState& s, const ContState& c, const TaskAction& a,
+                       const SymState& next, int effort, std::uint64_t seed);
+
+  /// Cheap: the TCP pose is inside the robot's reach sphere.
+  bool InReach(int robot, const Iso3& X_WT) const;
+  /// Cheap: robot's end effector with its TCP at X_WT does not hit the table.
+  bool ClearOfTable(int robot, const Iso3& X_WT);
+  /// The wrench gate for `objects` (cached by `key`, which must identify the question), with the
+  /// reason when infeasible. Mode none: always true.
+  bool Wrench(WrenchGate gate, std::span<const WrenchObject> objects, int mating_step,
+              std::uint64_t key, std::string* reason);
+  /// Whether some orientation of the candidate set lets the assembly LP of `step` hold with the
+  /// base in the air (cached by `key`).
+  bool AirAssemblyPossible(int step, const std::vector<std::pair<int, int>>& moved_holders,
+                           const std::vector<std::pair<int, int>>& base_holders,
+                           std::uint64_t key, std::string* reason);
+
+  /// TCP target of a robot holding node (at X_WA) with grasp id.
+  Iso3 GraspTarget(const Iso3& X_WA, int grasp_id) const;
+  /// Orientation candidates for an object whose insertion axis (in A) is `axis_A`: the axis
+  /// pointing down, sideways, up, each with 4 turns about it.
+  static std::vector<Mat3> AxisOrientations(const Vec3& axis_A);
+
+ private:
+  struct Mover {
+    int robot = -1;
+    int node = -1;
+    int grasp = -1;
+  };
+  struct Attempt;
+  bool SolveIk(int robot, const Iso3& X_WT, const JointVector& reference, int effort,
+               std::mt19937_64& rng, std::vector<JointVector>& out);
+  void SetScene(const std::vector<PlanObject>& objects, const std::vector<std::pair<int, int>>& holds,
+                int allow_a, int allow_b);
+  void SetRobot(int robot, const JointVector& q);
+  void EnableRobot(int robot, bool on);
+  bool Collides();
+  bool Search(const std::vector<Mover>& movers, const std::vector<std::vector<JointVector>>& sols,
+              size_t depth, std::vector<JointVector>& chosen, int& leaves, Gate& gate,
+              const std::function<bool(std::vector<JointVector>&)>& leaf);
+
+  const TaskWorld& world_;
+  TaskTables& tables_;
+  const TaskPlannerOptions& options_;
+  Cell cell_;
+  TaskCounters& counters_;
+  WrenchChecker checker_;
+  std::vector<std::vector<Iso3>> frames_;  // per robot scratch FK frames
+  std::vector<int> part_object_;           // scratch: object index of each part in SetScene
+};
+
+}  // namespace wrap

@@ -1,0 +1,156 @@
+// A task plan (paper §IV-D): the multi-robot action sequence with its keyframes, as the planner
+// produces it, the validator replays it, the renderer draws it and the plan JSON stores it.
+//
+// Semantics (the contract between planner, validator and renderer). The world holds *objects*:
+// the subassemblies that currently exist as separate rigid bodies (DAG node ids; at the start
+// every part is one). Each object has a pose X_WA of its assembly frame A (every part P of it at
+// X_WA * X_AP, X_AP from the project's assembled poses), is either resting on the table or in the
+// air, and has holders: robots gripping it, each with a grasp (part, X_PG). A robot holds at most
+// one object. Free robots wait at their home configuration; a holding robot keeps the
+// configuration of its last keyframe until an action moves it. Actions:
+//
+// - pick (robot r, object o, grasp g): r free; o resting, no holders. o does not move; r grasps it
+//   and lifts it: o is in the air, held by r.
+// - place (r, o, placement): r the only holder of o, o in the air. o is set down at the placement
+//   pose and r lets go: o rests, no holders; r goes home.
+// - handover (giver r1, receiver r2, o, g2): r1 the only holder of o, o in the air, r2 free. o may
+//   be moved to any pose (both arms reach it there); r2 grasps with g2, r1 lets go and goes home.
+// - add_grasp (r, o, g): r free, o resting or held. A resting o does not move (a brace); an o in
+//   the air may be moved by its holders to a new pose where r can also grasp it.
+// - release (r, o): r holds o, and o stays supported: it rests on the table or another robot still
+//   holds it. Nothing moves; r goes home.
+// - assemble (moved M, base B -> result S): M in the air, held; B resting or held. A resting B
+//   does not move; a B in the air may be moved by its holders. M is brought to its mating pose
+//   relative to B (X_WM = X_WB: both frames are the assembly frame) from an approach pose
+//   `approach_m` back along the insertion axis. S replaces M and B, with B's pose, resting if B
+//   rested, held by every robot that held M or B (the grasps carry over).
+//
+// An object in the air that an action moves is carried by all its holders (they all move). The
+// keyframe of an action is the moment of contact (pick, add_grasp, handover: the new grasp is
+// closed; place: the object touches the table; release: just before opening; assemble: mated);
+// it lists every robot's joints and every object's pose at that moment.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/pose.h"
+#include "core/run_context.h"
+#include "robot/kinematics.h"
+
+namespace wrap {
+
+/// The actions of the task planner (paper §IV-D).
+enum class ActionType { kPick, kPlace, kHandover, kAddGrasp, kRelease, kAssemble };
+
+/// "pick", "place", "handover", "add_grasp", "release", "assemble".
+std::string_view ToString(ActionType type);
+/// Inverse of ToString; nullopt for an unknown word.
+std::optional<ActionType> ActionTypeFromString(std::string_view word);
+
+/// A grasp as a plan records it: where it came from and what it is.
+struct PlanGrasp {
+  int subassembly = -1;          ///< Node id of the subassembly whose grasp set it was drawn from.
+  int index = -1;                ///< Index in that set (the set of the robot's end effector).
+  int part = -1;                 ///< Held part (index into Project::parts).
+  Iso3 X_PG = Iso3::Identity();  ///< Grasp (TCP) frame in the part frame.
+  double width_m = 0.0;          ///< Two-finger: the width the fingers close to [m]; vacuum 0.
+};
+
+/// A robot holding an object with a grasp.
+struct PlanHold {
+  int robot = -1;   ///< Index into Project::robots.
+  PlanGrasp grasp;  ///< The grasp.
+};
+
+/// Where a place action sets an object down (indices into the preprocessing's placements of the
+/// object's subassembly, its table slots and the slots' yaws).
+struct PlanPlacement {
+  int placement = -1;  ///< Stable placement class.
+  int slot = -1;       ///< Table slot.
+  int yaw = -1;        ///< Yaw index at the slot.
+};
+
+/// One object at a keyframe.
+struct PlanObject {
+  int node = -1;                 ///< DAG node id of the object (a part or a step's subassembly).
+  Iso3 X_WA = Iso3::Identity();  ///< Pose of its assembly frame in the world.
+  bool resting = false;          ///< Rests on the table (else in the air, held).
+};
+
+/// A snapshot of the cell.
+struct Keyframe {
+  std::vector<JointVector> q;       ///< Every robot's joints, in Project::robots order.
+  std::vector<PlanObject> objects;  ///< Every object that exists at that moment, by node id.
+};
+
+/// One action of a plan.
+struct PlanAction {
+  ActionType type = ActionType::kPick;  ///< What happens.
+  /// Robots that act: pick, place, add_grasp, release: {r}; handover: {giver, receiver};
+  /// assemble: every robot holding M or B (M's holders first).
+  std::vector<int> robots;
+  /// Objects (node ids): {o} for every type but assemble, which has {M, B, S}.
+  std::vector<int> objects;
+  /// One per entry of `robots`, same order: the grasp that robot has at the keyframe (pick,
+  /// add_grasp: the new one; handover: the giver's, then the receiver's new one; place, release:
+  /// the one let go; assemble: each holder's).
+  std::vector<PlanHold> grasps;
+  std::optional<PlanPlacement> placement;  ///< Place: where.
+  Keyframe keyframe;                       ///< The moment of the action (see the file comment).
+  /// Assemble: the moment before insertion, M `approach_m` back along the insertion axis; the
+  /// insertion is a straight move from here to `keyframe`.
+  std::optional<Keyframe> approach;
+  int milestone = -1;     ///< Index of the milestone (step in planning order) it belongs to.
+  double start_s = -1.0;  ///< Start time once retimed [s]; -1 before motion planning.
+  double end_s = -1.0;    ///< End time once retimed [s]; -1 before motion planning.
+};
+
+/// Statistics of a planner run (the paper's breakdown table and search counters).
+struct PlanStats {
+  bool solved = false;          ///< A plan was found.
+  int cost = 0;                 ///< Number of actions (the paper's cost).
+  double t_init_s = 0.0;        ///< Time to the first task plan, without preprocessing [s].
+  double t_grasp_s = 0.0;       ///< Preprocessing (grasps, placements, table slots) [s].
+  double t_bwd_s = 0.0;         ///< Backward (heuristic) search [s].
+  double t_lp_s = 0.0;          ///< Wrench LPs [s].
+  double t_fwd_s = 0.0;         ///< Forward search, without IK and LP [s].
+  double t_ik_s = 0.0;          ///< IK, collision and clearance checks of keyframes [s].
+  std::string planner;          ///< Planner variant, e.g. "counting".
+  std::uint64_t seed = 0;       ///< Seed of the run.
+  std::string wrench_mode;      ///< "full", "gravity" or "none".
+  double force_scale = 1.0;     ///< Lambda on the mating wrench.
+  int grasps = 0;               ///< Grasp-set size of the preprocessing.
+  long long expansions = 0;     ///< Search nodes expanded.
+  long long validations = 0;    ///< Edges validated (IK, collision, wrench).
+  long long validation_failures = 0;  ///< ... that failed.
+  long long lp_checks = 0;      ///< Wrench checks asked (cache hits included).
+  long long lp_cache_hits = 0;  ///< ... answered from the cache.
+  long long ik_calls = 0;       ///< IK queries.
+  long long collision_checks = 0;  ///< Cell collision queries.
+  int milestones = 0;           ///< Milestones (assembly steps) planned.
+  int backtracks = 0;           ///< Milestones re-planned after a later one failed.
+  int widenings = 0;            ///< Grasp and placement subsets widened.
+  std::string failure;          ///< Empty when solved, else why not, in words.
+};
+
+/// A plan of a project.
+struct Plan {
+  std::string project;                  ///< Project name.
+  std::vector<std::string> robots;      ///< Robot names, Project::robots order.
+  std::vector<std::string> parts;       ///< Part names, Project::parts order.
+  std::vector<std::string> nodes;       ///< DAG node names by node id (parts, then steps).
+  std::vector<int> milestone_steps;     ///< Step node id of each milestone, in planning order.
+  Keyframe initial;                     ///< Robots at home, parts at their initial poses.
+  std::vector<PlanAction> actions;      ///< The action sequence.
+  PlanStats stats;                      ///< How it was found.
+};
+
+/// The action in words, e.g. "r2 hands 'leg1' over to r3 (grasp 7 -> grasp 12)", with the
+/// plan's names.
+std::string DescribeAction(const Plan& plan, const PlanAction& action);
+
+}  // namespace wrap

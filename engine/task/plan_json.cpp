@@ -1,0 +1,853 @@
+#include "task/plan_json.h"
+
+#include <climits>
+#include <cmath>
+#include <initializer_list>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <utility>
+
+#include "core/file_io.h"
+#include "robot/catalog.h"
+
+namespace wrap {
+
+namespace {
+
+using json = nlohmann::json;
+using ojson = nlohmann::ordered_json;
+
+constexpr std::string_view kFormatName = "wrap-plan";
+constexpr int kFormatVersion = 1;
+
+// ---------------------------------------------------------------------------------------------
+// Writing
+
+// A name from one of the plan's lists; "#i" for an index outside it (never thrown away).
+std::string NameOr(const std::vector<std::string>& names, int i) {
+  if (i >= 0 && static_cast<size_t>(i) < names.size()) return names[i];
+  return "#" + std::to_string(i);
+}
+
+ojson Vec3Json(const Vec3& v) { return ojson::array({v.x(), v.y(), v.z()}); }
+
+ojson PoseJson(const Iso3& X) {
+  const Pose p = FromIsometry(X);
+  return ojson{{"xyz", Vec3Json(p.xyz)}, {"rpy", Vec3Json(p.rpy)}};
+}
+
+ojson KeyframeJson(const Plan& plan, const Keyframe& k) {
+  ojson q = ojson::object();
+  for (size_t r = 0; r < k.q.size(); ++r) {
+    ojson values = ojson::array();
+    for (Eigen::Index i = 0; i < k.q[r].size(); ++i) values.push_back(k.q[r][i]);
+    q[NameOr(plan.robots, static_cast<int>(r))] = values;
+  }
+  ojson objects = ojson::array();
+  for (const PlanObject& o : k.objects) {
+    objects.push_back(ojson{{"name", NameOr(plan.nodes, o.node)},
+                            {"X_WA", PoseJson(o.X_WA)},
+                            {"resting", o.resting}});
+  }
+  return ojson{{"q", q}, {"objects", objects}};
+}
+
+ojson StatsJson(const PlanStats& s) {
+  return ojson{{"solved", s.solved},
+               {"cost", s.cost},
+               {"t_init_s", s.t_init_s},
+               {"planner", s.planner},
+               {"seed", s.seed},
+               {"t_grasp_s", s.t_grasp_s},
+               {"t_bwd_s", s.t_bwd_s},
+               {"t_lp_s", s.t_lp_s},
+               {"t_fwd_s", s.t_fwd_s},
+               {"t_ik_s", s.t_ik_s},
+               {"wrench_mode", s.wrench_mode},
+               {"force_scale", s.force_scale},
+               {"grasps", s.grasps},
+               {"expansions", s.expansions},
+               {"validations", s.validations},
+               {"validation_failures", s.validation_failures},
+               {"lp_checks", s.lp_checks},
+               {"lp_cache_hits", s.lp_cache_hits},
+               {"ik_calls", s.ik_calls},
+               {"collision_checks", s.collision_checks},
+               {"milestones", s.milestones},
+               {"backtracks", s.backtracks},
+               {"widenings", s.widenings},
+               {"failure", s.failure}};
+}
+
+ojson ActionJson(const Plan& plan, const PlanAction& a, size_t index) {
+  ojson robots = ojson::array(), objects = ojson::array(), grasps = ojson::array();
+  for (int r : a.robots) robots.push_back(NameOr(plan.robots, r));
+  for (int o : a.objects) objects.push_back(NameOr(plan.nodes, o));
+  for (const PlanHold& h : a.grasps) {
+    grasps.push_back(ojson{{"robot", NameOr(plan.robots, h.robot)},
+                           {"subassembly", NameOr(plan.nodes, h.grasp.subassembly)},
+                           {"index", h.grasp.index},
+                           {"part", NameOr(plan.parts, h.grasp.part)},
+                           {"X_PG", PoseJson(h.grasp.X_PG)},
+                           {"width_m", h.grasp.width_m}});
+  }
+  ojson j{{"index", index},
+          {"type", std::string(ToString(a.type))},
+          {"robots", robots},
+          {"objects", objects},
+          {"grasps", grasps}};
+  if (a.placement) {
+    j["placement"] = ojson{{"placement", a.placement->placement},
+                           {"slot", a.placement->slot},
+                           {"yaw", a.placement->yaw}};
+  }
+  j["milestone"] = a.milestone;
+  if (a.start_s != -1.0) j["start_s"] = a.start_s;
+  if (a.end_s != -1.0) j["end_s"] = a.end_s;
+  j["keyframe"] = KeyframeJson(plan, a.keyframe);
+  if (a.approach) j["approach"] = KeyframeJson(plan, *a.approach);
+  j["description"] = DescribeAction(plan, a);
+  return j;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading: the first problem found is thrown as a BadField and turned into the Error at the
+// boundary (ParsePlan), so every helper can simply return the value it read.
+
+struct BadField {
+  std::string path;     // JSON path, e.g. "actions[3].keyframe.q.ur5e_a"; empty: the document.
+  std::string message;  // What is wrong.
+};
+
+[[noreturn]] void Bad(const std::string& path, std::string message) {
+  throw BadField{path, std::move(message)};
+}
+
+std::string Join(const std::string& path, std::string_view key) {
+  return path.empty() ? std::string(key) : path + "." + std::string(key);
+}
+
+std::string Index(const std::string& path, size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+std::string TypeName(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null:
+      return "null";
+    case json::value_t::object:
+      return "an object";
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::boolean:
+      return "a boolean";
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+      return "an integer";
+    case json::value_t::number_float:
+      return "a number";
+    default:
+      return "an unsupported value";
+  }
+}
+
+const json& ExpectObject(const json& j, const std::string& path) {
+  if (!j.is_object()) Bad(path, "expected an object, found " + TypeName(j));
+  return j;
+}
+
+const json& ExpectArray(const json& j, const std::string& path) {
+  if (!j.is_array()) Bad(path, "expected an array, found " + TypeName(j));
+  return j;
+}
+
+// Refuses keys of `obj` outside `known` (a typo would otherwise go unnoticed).
+void CheckKeys(const json& obj, const std::string& path,
+               std::initializer_list<std::string_view> known) {
+  for (const auto& [key, value] : obj.items()) {
+    bool found = false;
+    for (std::string_view k : known) found = found || key == k;
+    if (!found) {
+      std::string list;
+      for (std::string_view k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+      Bad(Join(path, key), "unknown field (known here: " + list + ")");
+    }
+  }
+}
+
+const json* Find(const json& obj, std::string_view key) {
+  auto it = obj.find(key);
+  return it == obj.end() ? nullptr : &*it;
+}
+
+const json& Member(const json& obj, const std::string& path, std::string_view key) {
+  const json* j = Find(obj, key);
+  if (!j) Bad(Join(path, key), "required field is missing");
+  return *j;
+}
+
+double NumberValue(const json& j, const std::string& path) {
+  if (!j.is_number()) Bad(path, "expected a number, found " + TypeName(j));
+  const double v = j.get<double>();
+  if (!std::isfinite(v)) Bad(path, "expected a finite number");
+  return v;
+}
+
+double Number(const json& obj, const std::string& path, std::string_view key) {
+  return NumberValue(Member(obj, path, key), Join(path, key));
+}
+
+double NonNegative(const json& obj, const std::string& path, std::string_view key) {
+  const double v = Number(obj, path, key);
+  if (v < 0.0) Bad(Join(path, key), "expected a number >= 0, found " + std::to_string(v));
+  return v;
+}
+
+long long IntegerValue(const json& j, const std::string& path, long long lo, long long hi) {
+  if (!j.is_number_integer()) {
+    Bad(path, "expected an integer, found " +
+                  (j.is_number() ? std::string("a fraction") : TypeName(j)));
+  }
+  const auto out_of_range = [&](const std::string& found) {
+    Bad(path, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                  "], found " + found);
+  };
+  if (j.is_number_unsigned()) {
+    const auto u = j.get<unsigned long long>();
+    if (u > static_cast<unsigned long long>(hi) ||
+        (lo > 0 && u < static_cast<unsigned long long>(lo))) {
+      out_of_range(std::to_string(u));
+    }
+    return static_cast<long long>(u);
+  }
+  const long long v = j.get<long long>();
+  if (v < lo || v > hi) out_of_range(std::to_string(v));
+  return v;
+}
+
+int Int(const json& obj, const std::string& path, std::string_view key, int lo = INT_MIN,
+        int hi = INT_MAX) {
+  return static_cast<int>(IntegerValue(Member(obj, path, key), Join(path, key), lo, hi));
+}
+
+long long Count(const json& obj, const std::string& path, std::string_view key) {
+  return IntegerValue(Member(obj, path, key), Join(path, key), 0, LLONG_MAX);
+}
+
+bool Bool(const json& obj, const std::string& path, std::string_view key) {
+  const json& j = Member(obj, path, key);
+  if (!j.is_boolean()) Bad(Join(path, key), "expected true or false, found " + TypeName(j));
+  return j.get<bool>();
+}
+
+std::string StringValue(const json& j, const std::string& path) {
+  if (!j.is_string()) Bad(path, "expected a string, found " + TypeName(j));
+  return j.get<std::string>();
+}
+
+std::string String(const json& obj, const std::string& path, std::string_view key) {
+  return StringValue(Member(obj, path, key), Join(path, key));
+}
+
+// A list of unique, non-empty names.
+std::vector<std::string> Names(const json& obj, const std::string& path, std::string_view key,
+                               bool allow_empty_list) {
+  const std::string at = Join(path, key);
+  const json& list = ExpectArray(Member(obj, path, key), at);
+  if (list.empty() && !allow_empty_list) Bad(at, "expected at least one name");
+  std::vector<std::string> names;
+  std::set<std::string> seen;
+  for (size_t i = 0; i < list.size(); ++i) {
+    std::string name = StringValue(list[i], Index(at, i));
+    if (name.empty()) Bad(Index(at, i), "empty name");
+    if (!seen.insert(name).second) Bad(Index(at, i), "duplicate name '" + name + "'");
+    names.push_back(std::move(name));
+  }
+  return names;
+}
+
+Vec3 Vector3(const json& obj, const std::string& path, std::string_view key) {
+  const std::string at = Join(path, key);
+  const json& j = Member(obj, path, key);
+  if (!j.is_array() || j.size() != 3) {
+    Bad(at, "expected an array of 3 numbers, found " +
+                (j.is_array() ? "an array of " + std::to_string(j.size()) : TypeName(j)));
+  }
+  Vec3 v;
+  for (size_t i = 0; i < 3; ++i) v[static_cast<Eigen::Index>(i)] = NumberValue(j[i], Index(at, i));
+  return v;
+}
+
+Iso3 PoseValue(const json& obj, const std::string& path, std::string_view key) {
+  const std::string at = Join(path, key);
+  const json& j = ExpectObject(Member(obj, path, key), at);
+  CheckKeys(j, at, {"xyz", "rpy"});
+  Pose pose;
+  pose.xyz = Vector3(j, at, "xyz");
+  pose.rpy = Vector3(j, at, "rpy");
+  return ToIsometry(pose);
+}
+
+// The plan's name lists as lookups, and the joint-vector size of each robot (from `initial`).
+class PlanReader {
+ public:
+  explicit PlanReader(Plan& plan) : plan_(plan) {}
+
+  void IndexNames() {
+    for (size_t i = 0; i < plan_.robots.size(); ++i) robots_[plan_.robots[i]] = int(i);
+    for (size_t i = 0; i < plan_.parts.size(); ++i) parts_[plan_.parts[i]] = int(i);
+    for (size_t i = 0; i < plan_.nodes.size(); ++i) nodes_[plan_.nodes[i]] = int(i);
+  }
+
+  int RobotValue(const json& j, const std::string& path) const {
+    return Lookup(robots_, StringValue(j, path), path, "robot", "robots");
+  }
+  int NodeValue(const json& j, const std::string& path) const {
+    return Lookup(nodes_, StringValue(j, path), path, "node", "nodes");
+  }
+  int PartValue(const json& j, const std::string& path) const {
+    return Lookup(parts_, StringValue(j, path), path, "part", "parts");
+  }
+
+  Keyframe ReadKeyframe(const json& obj, const std::string& path, std::string_view key) {
+    const std::string at = Join(path, key);
+    const json& j = ExpectObject(Member(obj, path, key), at);
+    CheckKeys(j, at, {"q", "objects"});
+    Keyframe k;
+    const std::string q_at = Join(at, "q");
+    const json& q = ExpectObject(Member(j, at, "q"), q_at);
+    for (const auto& [name, value] : q.items()) {
+      if (!robots_.contains(name)) Bad(Join(q_at, name), "unknown robot (not in \"robots\")");
+    }
+    const bool first = dof_.empty();
+    for (size_t r = 0; r < plan_.robots.size(); ++r) {
+      const std::string& name = plan_.robots[r];
+      const std::string r_at = Join(q_at, name);
+      const json* values = Find(q, name);
+      if (!values) Bad(r_at, "joint values of robot '" + name + "' are missing");
+      if (!values->is_array() || values->empty() || values->size() > size_t(kMaxDof)) {
+        Bad(r_at, "expected an array of 1 to " + std::to_string(kMaxDof) + " numbers, found " +
+                      (values->is_array() ? "an array of " + std::to_string(values->size())
+                                          : TypeName(*values)));
+      }
+      if (first) dof_.push_back(values->size());
+      if (values->size() != dof_[r]) {
+        Bad(r_at, "expected " + std::to_string(dof_[r]) + " numbers (as in initial.q." + name +
+                      "), found " + std::to_string(values->size()));
+      }
+      JointVector v(static_cast<Eigen::Index>(values->size()));
+      for (size_t i = 0; i < values->size(); ++i) {
+        v[static_cast<Eigen::Index>(i)] = NumberValue((*values)[i], Index(r_at, i));
+      }
+      k.q.push_back(v);
+    }
+    const std::string o_at = Join(at, "objects");
+    const json& objects = ExpectArray(Member(j, at, "objects"), o_at);
+    std::set<int> seen;
+    for (size_t i = 0; i < objects.size(); ++i) {
+      const std::string e_at = Index(o_at, i);
+      const json& e = ExpectObject(objects[i], e_at);
+      CheckKeys(e, e_at, {"name", "X_WA", "resting"});
+      PlanObject o;
+      o.node = NodeValue(Member(e, e_at, "name"), Join(e_at, "name"));
+      if (!seen.insert(o.node).second) {
+        Bad(Join(e_at, "name"), "object '" + plan_.nodes[o.node] + "' is listed twice");
+      }
+      o.X_WA = PoseValue(e, e_at, "X_WA");
+      o.resting = Bool(e, e_at, "resting");
+      k.objects.push_back(o);
+    }
+    return k;
+  }
+
+  PlanAction ReadAction(const json& j, const std::string& at, size_t index) {
+    ExpectObject(j, at);
+    CheckKeys(j, at,
+              {"index", "type", "robots", "objects", "grasps", "placement", "milestone", "start_s",
+               "end_s", "keyframe", "approach", "description"});
+    PlanAction a;
+    const int i = Int(j, at, "index");
+    if (i != static_cast<int>(index)) {
+      Bad(Join(at, "index"), "expected " + std::to_string(index) + " (the action's position), " +
+                                 "found " + std::to_string(i));
+    }
+    const std::string type = String(j, at, "type");
+    const auto t = ActionTypeFromString(type);
+    if (!t) {
+      Bad(Join(at, "type"), "unknown action type '" + type +
+                                "' (known: pick, place, handover, add_grasp, release, assemble)");
+    }
+    a.type = *t;
+
+    const std::string r_at = Join(at, "robots");
+    const json& robots = ExpectArray(Member(j, at, "robots"), r_at);
+    for (size_t k = 0; k < robots.size(); ++k) {
+      const int r = RobotValue(robots[k], Index(r_at, k));
+      for (int prev : a.robots) {
+        if (prev == r) Bad(Index(r_at, k), "robot '" + plan_.robots[r] + "' is listed twice");
+      }
+      a.robots.push_back(r);
+    }
+    const std::string o_at = Join(at, "objects");
+    const json& objects = ExpectArray(Member(j, at, "objects"), o_at);
+    for (size_t k = 0; k < objects.size(); ++k) {
+      const int o = NodeValue(objects[k], Index(o_at, k));
+      for (int prev : a.objects) {
+        if (prev == o) Bad(Index(o_at, k), "object '" + plan_.nodes[o] + "' is listed twice");
+      }
+      a.objects.push_back(o);
+    }
+    CheckArity(a, type, at);
+
+    const std::string g_at = Join(at, "grasps");
+    const json& grasps = ExpectArray(Member(j, at, "grasps"), g_at);
+    if (grasps.size() != a.robots.size()) {
+      Bad(g_at, "expected one grasp per robot (" + std::to_string(a.robots.size()) + "), found " +
+                    std::to_string(grasps.size()));
+    }
+    for (size_t k = 0; k < grasps.size(); ++k) {
+      a.grasps.push_back(ReadHold(grasps[k], Index(g_at, k), a.robots[k]));
+    }
+
+    if (const json* p = Find(j, "placement")) {
+      const std::string p_at = Join(at, "placement");
+      if (a.type != ActionType::kPlace) Bad(p_at, "only a place action has a placement");
+      ExpectObject(*p, p_at);
+      CheckKeys(*p, p_at, {"placement", "slot", "yaw"});
+      a.placement = PlanPlacement{Int(*p, p_at, "placement", 0), Int(*p, p_at, "slot", 0),
+                                  Int(*p, p_at, "yaw", 0)};
+    }
+    if (Find(j, "milestone")) {
+      a.milestone =
+          Int(j, at, "milestone", -1, static_cast<int>(plan_.milestone_steps.size()) - 1);
+    }
+    if (Find(j, "start_s")) a.start_s = NonNegative(j, at, "start_s");
+    if (Find(j, "end_s")) a.end_s = NonNegative(j, at, "end_s");
+    if (a.start_s >= 0.0 && a.end_s >= 0.0 && a.end_s < a.start_s) {
+      Bad(Join(at, "end_s"), "ends before it starts (start_s " + std::to_string(a.start_s) + ")");
+    }
+    a.keyframe = ReadKeyframe(j, at, "keyframe");
+    if (Find(j, "approach")) {
+      if (a.type != ActionType::kAssemble) {
+        Bad(Join(at, "approach"), "only an assemble action has an approach keyframe");
+      }
+      a.approach = ReadKeyframe(j, at, "approach");
+    }
+    if (const json* d = Find(j, "description")) StringValue(*d, Join(at, "description"));
+    return a;
+  }
+
+ private:
+  static int Lookup(const std::map<std::string, int>& names, const std::string& name,
+                    const std::string& path, const char* what, const char* list) {
+    auto it = names.find(name);
+    if (it == names.end()) {
+      Bad(path, "unknown " + std::string(what) + " '" + name + "' (not in \"" + list + "\")");
+    }
+    return it->second;
+  }
+
+  // The robot and object counts each action type has (plan.h, PlanAction).
+  static void CheckArity(const PlanAction& a, const std::string& type, const std::string& at) {
+    const std::string an = std::string(type[0] == 'a' ? "an " : "a ") + type;
+    size_t robots = 1, objects = 1;
+    if (a.type == ActionType::kHandover) robots = 2;
+    if (a.type == ActionType::kAssemble) objects = 3;
+    if (a.type == ActionType::kAssemble ? a.robots.empty() : a.robots.size() != robots) {
+      Bad(Join(at, "robots"), an + " action has " +
+                                  (a.type == ActionType::kAssemble ? std::string("at least 1")
+                                                                   : std::to_string(robots)) +
+                                  " robot(s), found " + std::to_string(a.robots.size()));
+    }
+    if (a.objects.size() != objects) {
+      Bad(Join(at, "objects"),
+          an + " action has " + std::to_string(objects) + " object(s)" +
+              (objects == 3 ? " (moved, base, result)" : "") + ", found " +
+              std::to_string(a.objects.size()));
+    }
+  }
+
+  PlanHold ReadHold(const json& j, const std::string& at, int robot) const {
+    ExpectObject(j, at);
+    CheckKeys(j, at, {"robot", "subassembly", "index", "part", "X_PG", "width_m"});
+    PlanHold h;
+    h.robot = RobotValue(Member(j, at, "robot"), Join(at, "robot"));
+    if (h.robot != robot) {
+      Bad(Join(at, "robot"), "expected '" + plan_.robots[robot] +
+                                 "' (grasps follow the action's robots), found '" +
+                                 plan_.robots[h.robot] + "'");
+    }
+    h.grasp.subassembly = NodeValue(Member(j, at, "subassembly"), Join(at, "subassembly"));
+    h.grasp.index = Int(j, at, "index", 0);
+    h.grasp.part = PartValue(Member(j, at, "part"), Join(at, "part"));
+    h.grasp.X_PG = PoseValue(j, at, "X_PG");
+    h.grasp.width_m = NonNegative(j, at, "width_m");
+    return h;
+  }
+
+  Plan& plan_;
+  std::map<std::string, int> robots_, parts_, nodes_;
+  std::vector<size_t> dof_;  // Joint-vector size per robot, from the first keyframe read.
+};
+
+PlanStats ReadStats(const json& root, const std::string& at) {
+  const json& j = ExpectObject(Member(root, "", "stats"), at);
+  CheckKeys(j, at,
+            {"solved", "cost", "t_init_s", "planner", "seed", "t_grasp_s", "t_bwd_s", "t_lp_s",
+             "t_fwd_s", "t_ik_s", "wrench_mode", "force_scale", "grasps", "expansions",
+             "validations", "validation_failures", "lp_checks", "lp_cache_hits", "ik_calls",
+             "collision_checks", "milestones", "backtracks", "widenings", "failure"});
+  PlanStats s;
+  // Required: what DESIGN.md promises every plan file holds.
+  s.solved = Bool(j, at, "solved");
+  s.cost = Int(j, at, "cost", 0);
+  s.t_init_s = NonNegative(j, at, "t_init_s");
+  s.planner = String(j, at, "planner");
+  {
+    const json& seed = Member(j, at, "seed");
+    if (!seed.is_number_integer() || (!seed.is_number_unsigned() && seed.get<long long>() < 0)) {
+      Bad(Join(at, "seed"), "expected an integer >= 0, found " + TypeName(seed));
+    }
+    s.seed = seed.get<std::uint64_t>();
+  }
+  // Optional: the breakdown and counters.
+  auto time = [&](const char* key, double& out) {
+    if (Find(j, key)) out = NonNegative(j, at, key);
+  };
+  auto count = [&](const char* key, long long& out) {
+    if (Find(j, key)) out = Count(j, at, key);
+  };
+  auto small = [&](const char* key, int& out) {
+    if (Find(j, key)) out = Int(j, at, key, 0);
+  };
+  time("t_grasp_s", s.t_grasp_s);
+  time("t_bwd_s", s.t_bwd_s);
+  time("t_lp_s", s.t_lp_s);
+  time("t_fwd_s", s.t_fwd_s);
+  time("t_ik_s", s.t_ik_s);
+  if (Find(j, "wrench_mode")) s.wrench_mode = String(j, at, "wrench_mode");
+  if (Find(j, "force_scale")) s.force_scale = Number(j, at, "force_scale");
+  small("grasps", s.grasps);
+  count("expansions", s.expansions);
+  count("validations", s.validations);
+  count("validation_failures", s.validation_failures);
+  count("lp_checks", s.lp_checks);
+  count("lp_cache_hits", s.lp_cache_hits);
+  count("ik_calls", s.ik_calls);
+  count("collision_checks", s.collision_checks);
+  small("milestones", s.milestones);
+  small("backtracks", s.backtracks);
+  small("widenings", s.widenings);
+  if (Find(j, "failure")) s.failure = String(j, at, "failure");
+  return s;
+}
+
+Plan ReadPlan(const json& root) {
+  if (!root.is_object()) Bad("", "expected a JSON object at the top level, found " + TypeName(root));
+  CheckKeys(root, "",
+            {"format", "version", "project", "robots", "parts", "nodes", "milestones", "stats",
+             "initial", "actions"});
+  const std::string format = String(root, "", "format");
+  if (format != kFormatName) {
+    Bad("format", "expected \"" + std::string(kFormatName) + "\", found \"" + format + "\"");
+  }
+  const json& version = Member(root, "", "version");
+  if (!version.is_number_integer() || version.get<long long>() != kFormatVersion) {
+    Bad("version", "expected " + std::to_string(kFormatVersion) + " (the version this build " +
+                       "reads), found " + version.dump());
+  }
+
+  Plan plan;
+  plan.project = String(root, "", "project");
+  plan.robots = Names(root, "", "robots", false);
+  plan.parts = Names(root, "", "parts", false);
+  plan.nodes = Names(root, "", "nodes", false);
+  if (plan.nodes.size() < plan.parts.size()) {
+    Bad("nodes", "expected the parts first, then the steps: " +
+                     std::to_string(plan.parts.size()) + " parts but only " +
+                     std::to_string(plan.nodes.size()) + " nodes");
+  }
+  for (size_t i = 0; i < plan.parts.size(); ++i) {
+    if (plan.nodes[i] != plan.parts[i]) {
+      Bad(Index("nodes", i), "expected part '" + plan.parts[i] + "' (nodes list the parts " +
+                                 "first, in \"parts\" order), found '" + plan.nodes[i] + "'");
+    }
+  }
+  PlanReader reader(plan);
+  reader.IndexNames();
+  const json& milestones = ExpectArray(Member(root, "", "milestones"), "milestones");
+  for (size_t i = 0; i < milestones.size(); ++i) {
+    const std::string at = Index("milestones", i);
+    const int node = reader.NodeValue(milestones[i], at);
+    if (node < static_cast<int>(plan.parts.size())) {
+      Bad(at, "'" + plan.nodes[node] + "' is a part, not an assembly step");
+    }
+    for (int prev : plan.milestone_steps) {
+      if (prev == node) Bad(at, "step '" + plan.nodes[node] + "' is listed twice");
+    }
+    plan.milestone_steps.push_back(node);
+  }
+  plan.stats = ReadStats(root, "stats");
+  plan.initial = reader.ReadKeyframe(root, "", "initial");
+  const json& actions = ExpectArray(Member(root, "", "actions"), "actions");
+  for (size_t i = 0; i < actions.size(); ++i) {
+    plan.actions.push_back(reader.ReadAction(actions[i], Index("actions", i), i));
+  }
+  return plan;
+}
+
+// Strips nlohmann's "[json.exception.parse_error.101] " prefix.
+std::string CleanJsonMessage(const std::string& what) {
+  const auto pos = what.find("] ");
+  return pos == std::string::npos ? what : what.substr(pos + 2);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Matching a plan against a project
+
+std::string NameList(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  return list.empty() ? "none" : list;
+}
+
+// The same names in the same order; else which entry differs, with both lists.
+Result<void> SameNames(const std::vector<std::string>& plan_names,
+                       const std::vector<std::string>& project_names, const char* key,
+                       const char* what, const std::string& plan_file,
+                       const std::string& project_name) {
+  const size_t n = std::max(plan_names.size(), project_names.size());
+  for (size_t i = 0; i < n; ++i) {
+    if (i < plan_names.size() && i < project_names.size() && plan_names[i] == project_names[i]) {
+      continue;
+    }
+    std::string problem;
+    if (i >= plan_names.size()) {
+      problem = "the plan has no " + std::string(what) + " " + std::to_string(i) + ", the project "
+                "has '" + project_names[i] + "'";
+    } else if (i >= project_names.size()) {
+      problem = std::string(what) + " '" + plan_names[i] + "' is not in the project";
+    } else {
+      problem = "plan " + std::string(what) + " '" + plan_names[i] + "' where the project has '" +
+                project_names[i] + "'";
+    }
+    return Fail(ErrorCode::kInvalidInput,
+                plan_file + ": " + Index(key, i) + ": " + problem + ": the plan is for other " +
+                    key + " (" + NameList(plan_names) + ") than project '" + project_name + "' (" +
+                    NameList(project_names) + ")");
+  }
+  return {};
+}
+
+// Every part lies in exactly one object of the keyframe.
+Result<void> CheckPartition(const Plan& plan, const Keyframe& k, const AssemblyTree& tree,
+                            const std::string& path, const std::string& plan_file) {
+  std::vector<int> owner(plan.parts.size(), -1);
+  for (const PlanObject& o : k.objects) {
+    if (o.node < 0 || o.node >= static_cast<int>(tree.nodes.size())) {
+      return Fail(ErrorCode::kInvalidInput, plan_file + ": " + Join(path, "objects") +
+                                                ": node " + std::to_string(o.node) +
+                                                " is not in the project");
+    }
+    for (int p : tree.nodes[o.node].parts) {
+      if (p < 0 || p >= static_cast<int>(owner.size())) continue;
+      if (owner[p] >= 0) {
+        return Fail(ErrorCode::kInvalidInput,
+                    plan_file + ": " + Join(path, "objects") + ": part '" + plan.parts[p] +
+                        "' is in both '" + plan.nodes[owner[p]] + "' and '" + plan.nodes[o.node] +
+                        "'");
+      }
+      owner[p] = o.node;
+    }
+  }
+  for (size_t p = 0; p < owner.size(); ++p) {
+    if (owner[p] < 0) {
+      return Fail(ErrorCode::kInvalidInput, plan_file + ": " + Join(path, "objects") +
+                                                ": part '" + plan.parts[p] +
+                                                "' is in no object (every part must be in one)");
+    }
+  }
+  return {};
+}
+
+Result<void> CheckKeyframe(const Plan& plan, const Keyframe& k, const AssemblyTree& tree,
+                           const std::vector<int>& dof, const std::vector<std::string>& models,
+                           const std::string& path, const std::string& plan_file) {
+  if (k.q.size() != plan.robots.size()) {
+    return Fail(ErrorCode::kInvalidInput,
+                plan_file + ": " + Join(path, "q") + ": expected joint values of " +
+                    std::to_string(plan.robots.size()) + " robots, found " +
+                    std::to_string(k.q.size()));
+  }
+  for (size_t r = 0; r < k.q.size(); ++r) {
+    if (dof[r] < 0 || k.q[r].size() == dof[r]) continue;
+    return Fail(ErrorCode::kInvalidInput,
+                plan_file + ": " + Join(Join(path, "q"), plan.robots[r]) + ": expected " +
+                    std::to_string(dof[r]) + " numbers (robot model '" + models[r] +
+                    "' has " + std::to_string(dof[r]) + " joints), found " +
+                    std::to_string(k.q[r].size()));
+  }
+  return CheckPartition(plan, k, tree, path, plan_file);
+}
+
+}  // namespace
+
+std::string SerializePlan(const Plan& plan) {
+  ojson doc;
+  doc["format"] = kFormatName;
+  doc["version"] = kFormatVersion;
+  doc["project"] = plan.project;
+  doc["robots"] = plan.robots;
+  doc["parts"] = plan.parts;
+  doc["nodes"] = plan.nodes;
+  ojson milestones = ojson::array();
+  for (int s : plan.milestone_steps) milestones.push_back(NameOr(plan.nodes, s));
+  doc["milestones"] = milestones;
+  doc["stats"] = StatsJson(plan.stats);
+  doc["initial"] = KeyframeJson(plan, plan.initial);
+  ojson actions = ojson::array();
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    actions.push_back(ActionJson(plan, plan.actions[i], i));
+  }
+  doc["actions"] = actions;
+  // Keys keep the order written here (ordered_json); invalid UTF-8 in names is replaced, never
+  // thrown.
+  return doc.dump(2, ' ', false, ojson::error_handler_t::replace) + "\n";
+}
+
+Result<Plan> ParsePlan(std::string_view text, const std::string& origin) {
+  // Duplicate keys would silently keep one value: refuse them while parsing.
+  std::vector<std::set<std::string>> keys;
+  std::string duplicate;
+  const json::parser_callback_t on_event = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) {
+      keys.emplace_back();
+    } else if (event == json::parse_event_t::object_end) {
+      if (!keys.empty()) keys.pop_back();
+    } else if (event == json::parse_event_t::key && !keys.empty() && duplicate.empty()) {
+      const std::string key = parsed.get<std::string>();
+      if (!keys.back().insert(key).second) duplicate = key;
+    }
+    return true;
+  };
+  json root;
+  try {
+    root = json::parse(text.begin(), text.end(), on_event);
+  } catch (const json::exception& e) {
+    return Fail(ErrorCode::kInvalidInput,
+                origin + ": malformed JSON: " + CleanJsonMessage(e.what()));
+  } catch (const std::exception& e) {
+    return Fail(ErrorCode::kInvalidInput, origin + ": malformed JSON: " + e.what());
+  }
+  if (!duplicate.empty()) {
+    return Fail(ErrorCode::kInvalidInput,
+                origin + ": duplicate key \"" + duplicate + "\" in one object");
+  }
+  try {
+    return ReadPlan(root);
+  } catch (const BadField& e) {
+    return Fail(ErrorCode::kInvalidInput,
+                origin + ": " + (e.path.empty() ? "" : e.path + ": ") + e.message);
+  } catch (const std::exception& e) {
+    return Fail(ErrorCode::kInvalidInput, origin + ": unreadable plan: " + e.what());
+  }
+}
+
+Result<Plan> ReadPlanFile(const std::filesystem::path& path) {
+  auto text = ReadFile(path);
+  if (!text) return std::unexpected(text.error());
+  return ParsePlan(*text, path.string());
+}
+
+Result<void> SavePlan(const Plan& plan, const std::filesystem::path& path) {
+  return WriteFileAtomic(path, SerializePlan(plan));
+}
+
+Result<void> CheckPlanMatchesProject(const Plan& plan, const Project& project,
+                                     const AssemblyTree& tree, const std::string& plan_file) {
+  std::vector<std::string> robots, parts, nodes;
+  for (const Robot& r : project.robots) robots.push_back(r.name);
+  for (const Part& p : project.parts) parts.push_back(p.name);
+  for (const AssemblyNode& n : tree.nodes) nodes.push_back(n.name);
+  if (auto ok = SameNames(plan.robots, robots, "robots", "robot", plan_file, project.name); !ok) {
+    return ok;
+  }
+  if (auto ok = SameNames(plan.parts, parts, "parts", "part", plan_file, project.name); !ok) {
+    return ok;
+  }
+  if (auto ok = SameNames(plan.nodes, nodes, "nodes", "node", plan_file, project.name); !ok) {
+    return ok;
+  }
+  for (size_t i = 0; i < plan.milestone_steps.size(); ++i) {
+    const int s = plan.milestone_steps[i];
+    if (s < 0 || s >= static_cast<int>(tree.nodes.size()) || tree.nodes[s].step < 0) {
+      return Fail(ErrorCode::kInvalidInput, plan_file + ": " + Index("milestones", i) +
+                                                ": not an assembly step of the project");
+    }
+  }
+
+  // Joint-vector sizes of catalog robots (a URDF robot's chain is not loaded here: -1).
+  std::vector<int> dof(robots.size(), -1);
+  std::vector<std::string> models(robots.size());
+  for (size_t r = 0; r < project.robots.size(); ++r) {
+    models[r] = project.robots[r].model;
+    if (models[r].empty()) continue;
+    if (auto chain = LoadRobotModel(models[r])) dof[r] = chain->dof();
+  }
+  if (auto ok = CheckKeyframe(plan, plan.initial, tree, dof, models, "initial", plan_file); !ok) {
+    return ok;
+  }
+  const int n_nodes = static_cast<int>(tree.nodes.size());
+  const int n_parts = static_cast<int>(parts.size());
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    const PlanAction& a = plan.actions[i];
+    const std::string at = Index("actions", i);
+    auto bad = [&](const std::string& path, const std::string& problem) {
+      return Fail(ErrorCode::kInvalidInput, plan_file + ": " + path + ": " + problem);
+    };
+    for (size_t k = 0; k < a.robots.size(); ++k) {
+      if (a.robots[k] < 0 || a.robots[k] >= static_cast<int>(robots.size())) {
+        return bad(Index(Join(at, "robots"), k), "robot index out of range");
+      }
+    }
+    for (size_t k = 0; k < a.objects.size(); ++k) {
+      if (a.objects[k] < 0 || a.objects[k] >= n_nodes) {
+        return bad(Index(Join(at, "objects"), k), "node index out of range");
+      }
+    }
+    for (size_t k = 0; k < a.grasps.size(); ++k) {
+      const PlanGrasp& g = a.grasps[k].grasp;
+      const std::string g_at = Index(Join(at, "grasps"), k);
+      if (g.subassembly < 0 || g.subassembly >= n_nodes) {
+        return bad(Join(g_at, "subassembly"), "node index out of range");
+      }
+      if (g.part < 0 || g.part >= n_parts) return bad(Join(g_at, "part"), "part out of range");
+      const std::vector<int>& in = tree.nodes[g.subassembly].parts;
+      if (std::find(in.begin(), in.end(), g.part) == in.end()) {
+        return bad(Join(g_at, "part"), "part '" + parts[g.part] + "' is not in subassembly '" +
+                                           nodes[g.subassembly] + "'");
+      }
+    }
+    if (a.milestone < -1 || a.milestone >= static_cast<int>(plan.milestone_steps.size())) {
+      return bad(Join(at, "milestone"), "milestone index out of range");
+    }
+    if (auto ok = CheckKeyframe(plan, a.keyframe, tree, dof, models, Join(at, "keyframe"),
+                                plan_file);
+        !ok) {
+      return ok;
+    }
+    if (a.approach) {
+      if (auto ok = CheckKeyframe(plan, *a.approach, tree, dof, models, Join(at, "approach"),
+                                  plan_file);
+          !ok) {
+        return ok;
+      }
+    }
+  }
+  return {};
+}
+
+}  // namespace wrap

@@ -1,0 +1,54 @@
+// The task planner (paper §IV-D): from a preprocessed project to a validated multi-robot action
+// plan whose keyframes are reachable (IK), collision-free with the robots' minimum clearance, and
+// wrench-feasible (assembly, transport, release and rest gates of the wrench LP).
+//
+// "counting" is the paper's "Milestones + counting" variant: one milestone per assembly step in a
+// topological order; within a milestone a lazy weighted best-first search whose heuristic counts
+// the pick, assemble and release actions still required; edges are validated (IK, collision,
+// clearance, the wrench gates that depend on a sampled pose) only when they lie on the best
+// candidate plan; witnesses are cached; an edge that fails at one effort level is suspended and
+// revisited at the next; grasp and placement subsets are widened when a milestone fails; a
+// milestone that fails makes the previous one look for another end state (backtracking).
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "core/result.h"
+#include "core/run_context.h"
+#include "grasp/preprocess.h"
+#include "model/project.h"
+#include "model/validate.h"
+#include "task/plan.h"
+#include "wrench/wrench.h"
+
+namespace wrap {
+
+/// Options of PlanTask.
+struct TaskPlannerOptions {
+  std::string planner = "counting";  ///< Variant; "counting" (Milestones + counting).
+  MatingWrenchMode wrench_mode = MatingWrenchMode::kFull;  ///< full, gravity or none.
+  double force_scale = 1.0;      ///< Lambda on the mating force and torque, >= 0.
+  double min_clearance_m = 0.005;  ///< Least distance between two robots at a keyframe [m].
+  int max_effort = 2;            ///< Highest effort level (0-based) of the IK and pose sampling.
+  /// Widen the grasp and placement subsets when a milestone fails; absent: the project's
+  /// `planner.widen_grasps`.
+  std::optional<bool> widen;
+  int max_holders = 2;           ///< Most robots holding one object at once.
+  long long max_nodes = 400000;  ///< Search nodes kept per milestone search (memory bound).
+  int max_backtracks = 6;        ///< Milestone re-plans after later milestones failed.
+  std::filesystem::path project_file;  ///< Resolves URDF robots; may be empty.
+};
+
+/// Plans the task of a validated project (`check` from LoadProject, `pre` from Preprocess).
+/// Returns a plan with stats.solved = true, or with solved = false and stats.failure saying which
+/// milestone failed and why (the gate that failed most, for which robots and grasps) when none
+/// is found within the search space or the time limit of `ctx` (stats.failure then says so).
+/// Fails with kInvalidInput for an unknown variant or options out of range or a project the
+/// planner cannot set up (a robot model that does not load), kCancelled when ctx is cancelled.
+/// Deterministic: same inputs and ctx seed, same plan. Adds its stage times to ctx ("bwd", "lp",
+/// "fwd", "ik").
+Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const Preprocessed& pre,
+                      const TaskPlannerOptions& options, RunContext& ctx);
+
+}  // namespace wrap

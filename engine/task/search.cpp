@@ -1,0 +1,571 @@
+#include "task/search.h"
+
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <queue>
+#include <tuple>
+
+#include "grasp/table_slots.h"
+
+namespace wrap {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr int kPermanent = INT_MAX;
+constexpr int kWeight = 2;  // weighted best-first: f = g + 2 h
+
+std::uint64_t EdgeKey(const SymState& s, const TaskAction& a) {
+  return HashMix(s.Hash(), a.Hash());
+}
+
+}  // namespace
+
+void GateTally::Add(Gate gate, const std::string& message) {
+  const int i = static_cast<int>(gate);
+  ++count[i];
+  if (example[i].empty()) example[i] = message;
+}
+
+std::string GateTally::Summary(int max_gates) const {
+  std::vector<int> order;
+  for (int i = 1; i < kNumGates; ++i) {
+    if (count[i] > 0) order.push_back(i);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return count[a] > count[b]; });
+  std::string out;
+  for (int k = 0; k < static_cast<int>(order.size()) && k < max_gates; ++k) {
+    const int i = order[k];
+    if (!out.empty()) out += "; ";
+    out += std::string(GateName(static_cast<Gate>(i))) + " failed " + std::to_string(count[i]) +
+           "x";
+    if (!example[i].empty()) out += " (e.g. " + example[i] + ")";
+  }
+  return out.empty() ? "no candidate action passed the cheap checks" : out;
+}
+
+TaskSearch::TaskSearch(const TaskWorld& world, TaskTables& tables, KeyframeSolver& solver,
+                       const TaskPlannerOptions& options, RunContext& ctx, std::uint64_t seed,
+                       bool widen)
+    : world_(world),
+      tables_(tables),
+      solver_(solver),
+      options_(options),
+      ctx_(ctx),
+      seed_(seed),
+      widen_(widen),
+      n_robots_(static_cast<int>(world.robots.size())) {}
+
+TaskSearch::Resolution TaskSearch::ResolutionAt(int level) const {
+  constexpr int kGrasps[] = {6, 12, 1 << 20};
+  constexpr int kPlacements[] = {2, 4, 1 << 20};
+  constexpr int kSlots[] = {3, 6, 1 << 20};
+  constexpr int kYaws[] = {2, 4, 1 << 20};
+  Resolution r;
+  r.grasps = widen_ ? kGrasps[level] : 1 << 20;
+  r.placements = kPlacements[level];
+  r.slots = kSlots[level];
+  r.yaws = kYaws[level];
+  return r;
+}
+
+const std::vector<int>& TaskSearch::GraspIds(int node, int robot) {
+  auto [it, inserted] = grasp_ids_.try_emplace({node, world_.robots[robot].grasp_set});
+  if (inserted) {
+    if (const GraspSet* set = world_.grasp_set(node, robot)) {
+      for (size_t i = 0; i < set->grasps.size(); ++i) {
+        const Grasp& g = set->grasps[i];
+        GraspRef ref{node, static_cast<int>(i), g.part, g.X_PG, g.width_m, g.quality};
+        // Grasp sets of different end effectors of one node are told apart by the index offset.
+        const int key_index = world_.robots[robot].grasp_set * 100000 + static_cast<int>(i);
+        it->second.push_back(tables_.Grasp(node, key_index, ref));
+      }
+    }
+  }
+  return it->second;
+}
+
+bool TaskSearch::GraspsApart(int grasp_a, int grasp_b) const {
+  const GraspRef& a = tables_.grasp(grasp_a);
+  const GraspRef& b = tables_.grasp(grasp_b);
+  const Vec3 pa = world_.X_AP[a.part] * a.X_PG.translation();
+  const Vec3 pb = world_.X_AP[b.part] * b.X_PG.translation();
+  return (pa - pb).norm() >= 0.04;
+}
+
+int TaskSearch::Heuristic(const SymState& s, const Milestone& m) const {
+  int h = 0;
+  const bool done = s.loc[m.step] != kInactive;
+  bool m_needs_grasp = false;
+  if (!done) {
+    h += 1;
+    m_needs_grasp = s.NumHolders(m.moved) == 0 || s.loc[m.moved] >= 0;
+    if (m_needs_grasp) h += 1;
+  }
+  if (m.final) {
+    for (int r = 0; r < n_robots_; ++r) h += s.held[r] >= 0;
+    if (m_needs_grasp) h += 1;
+  }
+  return h;
+}
+
+bool TaskSearch::IsGoal(const SymState& s, const Milestone& m,
+                        const std::set<std::uint64_t>& excluded) const {
+  if (s.loc[m.step] == kInactive) return false;
+  if (m.final) {
+    for (int r = 0; r < n_robots_; ++r) {
+      if (s.held[r] >= 0) return false;
+    }
+  }
+  return excluded.empty() || !excluded.contains(s.Hash());
+}
+
+SymState TaskSearch::Apply(const SymState& s, const TaskAction& a) const {
+  SymState n = s;
+  switch (a.type) {
+    case ActionType::kPick:
+      n.loc[a.obj] = kInAir;
+      n.held[a.r1] = a.obj;
+      n.grasp[a.r1] = a.grasp;
+      break;
+    case ActionType::kPlace:
+      n.loc[a.obj] = static_cast<int16_t>(a.loc);
+      n.held[a.r1] = -1;
+      n.grasp[a.r1] = -1;
+      break;
+    case ActionType::kHandover:
+      n.held[a.r1] = -1;
+      n.grasp[a.r1] = -1;
+      n.held[a.r2] = a.obj;
+      n.grasp[a.r2] = a.grasp;
+      break;
+    case ActionType::kAddGrasp:
+      n.held[a.r1] = a.obj;
+      n.grasp[a.r1] = a.grasp;
+      break;
+    case ActionType::kRelease:
+      n.held[a.r1] = -1;
+      n.grasp[a.r1] = -1;
+      break;
+    case ActionType::kAssemble: {
+      const StepInterface& st = world_.interface(a.obj);
+      const int16_t base_loc = s.loc[st.base];
+      n.loc[a.obj] = base_loc >= 0
+                         ? static_cast<int16_t>(const_cast<TaskTables&>(tables_).DerivedLocation(
+                               a.obj, base_loc, tables_.location(base_loc).X_WA))
+                         : kInAir;
+      n.loc[st.moved] = kInactive;
+      n.loc[st.base] = kInactive;
+      for (int r = 0; r < n_robots_; ++r) {
+        if (n.held[r] == st.moved || n.held[r] == st.base) n.held[r] = static_cast<int16_t>(a.obj);
+      }
+      break;
+    }
+  }
+  return n;
+}
+
+bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
+  std::uint64_t key = HashMix(HashMix(HashMix(HashMix(101, robot), node), loc), grasp);
+  auto it = cheap_.find(key);
+  if (it != cheap_.end()) return it->second;
+  const Iso3 X_WA = tables_.location(loc).X_WA;
+  const Iso3 target = solver_.GraspTarget(X_WA, grasp);
+  bool ok = solver_.InReach(robot, target) && solver_.ClearOfTable(robot, target);
+  if (ok) {
+    // Transport right after the lift: deterministic, so checked here.
+    const WrenchObject obj{node, X_WA, false, {{robot, grasp}}};
+    std::string why;
+    const std::uint64_t lp_key =
+        HashMix(HashMix(HashMix(1, static_cast<std::uint64_t>(loc) + 100), robot), grasp);
+    ok = solver_.Wrench(WrenchGate::kTransport, {&obj, 1}, -1, lp_key, &why);
+    if (!ok) tally_.Add(Gate::kWrenchTransport, why);
+  }
+  cheap_[key] = ok;
+  return ok;
+}
+
+bool TaskSearch::CheapPlace(int robot, int node, int loc, int grasp) {
+  std::uint64_t key = HashMix(HashMix(HashMix(HashMix(102, robot), node), loc), grasp);
+  auto it = cheap_.find(key);
+  if (it != cheap_.end()) return it->second;
+  const Iso3 X_WA = tables_.location(loc).X_WA;
+  const Iso3 target = solver_.GraspTarget(X_WA, grasp);
+  bool ok = solver_.InReach(robot, target) && solver_.ClearOfTable(robot, target);
+  if (ok) {
+    const WrenchObject obj{node, X_WA, true, {}};
+    std::string why;
+    ok = solver_.Wrench(WrenchGate::kRest, {&obj, 1}, -1, HashMix(2, loc + 1), &why);
+    if (!ok) tally_.Add(Gate::kWrenchRest, why);
+  }
+  cheap_[key] = ok;
+  return ok;
+}
+
+bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
+  std::vector<std::pair<int, int>> mh, bh;
+  for (int r = 0; r < n_robots_; ++r) {
+    if (s.held[r] == m.moved) mh.push_back({r, s.grasp[r]});
+    if (s.held[r] == m.base) bh.push_back({r, s.grasp[r]});
+  }
+  const bool b_rests = s.loc[m.base] >= 0;
+  std::uint64_t key = HashMix(103, m.step);
+  key = HashMix(key, b_rests ? static_cast<std::uint64_t>(s.loc[m.base]) + 7 : 3);
+  for (const auto& [r, g] : mh) key = HashMix(HashMix(key, r), g);
+  key = HashMix(key, 999);
+  for (const auto& [r, g] : bh) key = HashMix(HashMix(key, r), g);
+  auto it = cheap_.find(key);
+  if (it != cheap_.end()) return it->second;
+  bool ok = true;
+  std::string why;
+  if (b_rests) {
+    const Iso3 X_WB = tables_.location(s.loc[m.base]).X_WA;
+    for (const auto& [r, g] : mh) {
+      const Iso3 target = solver_.GraspTarget(X_WB, g);
+      if (!solver_.InReach(r, target) || !solver_.ClearOfTable(r, target)) ok = false;
+    }
+    if (ok && LowestPoint(world_, m.moved, X_WB) < world_.table_top - 1e-3) ok = false;
+    if (ok) {
+      const WrenchObject objs[2] = {{m.moved, X_WB, false, mh}, {m.base, X_WB, true, bh}};
+      std::uint64_t lp_key = HashMix(3, static_cast<std::uint64_t>(m.step));
+      lp_key = HashMix(lp_key, static_cast<std::uint64_t>(s.loc[m.base]) + 7);
+      for (const auto& [r, g] : mh) lp_key = HashMix(HashMix(lp_key, r), g);
+      lp_key = HashMix(lp_key, 999);
+      for (const auto& [r, g] : bh) lp_key = HashMix(HashMix(lp_key, r), g);
+      ok = solver_.Wrench(WrenchGate::kAssembly, objs, m.step, lp_key, &why);
+      if (!ok) tally_.Add(Gate::kWrenchAssembly, why);
+    }
+  } else {
+    ok = solver_.AirAssemblyPossible(m.step, mh, bh, key, &why);
+    if (!ok) tally_.Add(Gate::kWrenchAssembly, why);
+  }
+  cheap_[key] = ok;
+  return ok;
+}
+
+void TaskSearch::Successors(const SymState& s, const Milestone& m, const Resolution& res,
+                            std::vector<std::pair<TaskAction, SymState>>& out) {
+  out.clear();
+  const bool done = s.loc[m.step] != kInactive;
+  int focus[2] = {-1, -1};
+  int n_focus = 0;
+  if (!done) {
+    focus[n_focus++] = m.moved;
+    focus[n_focus++] = m.base;
+  } else if (m.final) {
+    focus[n_focus++] = m.step;
+  }
+  auto push = [&](const TaskAction& a) { out.push_back({a, Apply(s, a)}); };
+  const TableSlots& slots = world_.pre->table_slots;
+
+  for (int r = 0; r < n_robots_; ++r) {
+    if (s.held[r] < 0) {
+      for (int f = 0; f < n_focus; ++f) {
+        const int o = focus[f];
+        const int16_t loc = s.loc[o];
+        const int holders = s.NumHolders(o);
+        const std::vector<int>& ids = GraspIds(o, r);
+        const int n_grasps = std::min<int>(res.grasps, static_cast<int>(ids.size()));
+        // Pick a resting object nobody holds.
+        if (loc >= 0 && holders == 0 && !done) {
+          for (int i = 0; i < n_grasps; ++i) {
+            if (!CheapPick(r, o, loc, ids[i])) continue;
+            TaskAction a;
+            a.type = ActionType::kPick;
+            a.r1 = static_cast<int8_t>(r);
+            a.obj = static_cast<int16_t>(o);
+            a.grasp = ids[i];
+            push(a);
+          }
+        }
+        // Add a grasp: a brace on a resting base, or a second hand on an object in the air.
+        const bool brace = loc >= 0 && o == m.base && !done;
+        const bool carry = loc == kInAir && holders >= 1;
+        if ((brace || carry) && holders < options_.max_holders) {
+          for (int i = 0; i < n_grasps; ++i) {
+            bool apart = true;
+            for (int q = 0; q < n_robots_; ++q) {
+              if (s.held[q] == o && !GraspsApart(s.grasp[q], ids[i])) apart = false;
+            }
+            if (!apart) continue;
+            if (loc >= 0 && !CheapPick(r, o, loc, ids[i])) continue;
+            TaskAction a;
+            a.type = ActionType::kAddGrasp;
+            a.r1 = static_cast<int8_t>(r);
+            a.obj = static_cast<int16_t>(o);
+            a.grasp = ids[i];
+            push(a);
+          }
+        }
+        // Handover from a sole holder in the air.
+        if (loc == kInAir && holders == 1) {
+          int giver = -1;
+          for (int q = 0; q < n_robots_; ++q) {
+            if (s.held[q] == o) giver = q;
+          }
+          for (int i = 0; i < n_grasps; ++i) {
+            if (!GraspsApart(s.grasp[giver], ids[i])) continue;
+            TaskAction a;
+            a.type = ActionType::kHandover;
+            a.r1 = static_cast<int8_t>(giver);
+            a.r2 = static_cast<int8_t>(r);
+            a.obj = static_cast<int16_t>(o);
+            a.grasp = ids[i];
+            push(a);
+          }
+        }
+      }
+      continue;
+    }
+    // r holds something.
+    const int o = s.held[r];
+    const int16_t loc = s.loc[o];
+    const int holders = s.NumHolders(o);
+    if (loc >= 0 || holders >= 2) {
+      TaskAction a;
+      a.type = ActionType::kRelease;
+      a.r1 = static_cast<int8_t>(r);
+      a.obj = static_cast<int16_t>(o);
+      push(a);
+    }
+    if (loc == kInAir && holders == 1) {
+      const auto& placements = world_.pre->subassemblies[o].placements;
+      const int n_place = std::min<int>(res.placements, static_cast<int>(placements.size()));
+      int slots_used = 0;
+      for (size_t si = 0; si < slots.slots.size() && slots_used < res.slots; ++si) {
+        const TableSlot& slot = slots.slots[si];
+        if (std::find(slot.robots.begin(), slot.robots.end(), r) == slot.robots.end()) continue;
+        // Skip slots next to another resting object.
+        bool free = true;
+        const Aabb& box_o = world_.pre->subassemblies[o].aabb_A;
+        const double r_o = 0.5 * (box_o.max - box_o.min).head<2>().norm();
+        for (int n = 0; n < world_.num_nodes && free; ++n) {
+          if (n == o || s.loc[n] < 0) continue;
+          const Aabb& box_n = world_.pre->subassemblies[n].aabb_A;
+          const double r_n = 0.5 * (box_n.max - box_n.min).head<2>().norm();
+          const Vec3 c_n = tables_.location(s.loc[n]).X_WA *
+                           Vec3(world_.pre->subassemblies[n].com_A);
+          if ((c_n - slot.p_W).head<2>().norm() < r_o + r_n) free = false;
+        }
+        if (!free) continue;
+        ++slots_used;
+        const int n_yaws = static_cast<int>(slots.yaws_rad.size());
+        const int yaw_step = std::max(1, n_yaws / std::max(1, std::min(res.yaws, n_yaws)));
+        for (int p = 0; p < n_place; ++p) {
+          for (int y = 0; y < n_yaws; y += yaw_step) {
+            const Iso3 X = PlacementPose(slot, slots.yaws_rad[y], placements[p]);
+            const int id = tables_.PlacedLocation(o, p, static_cast<int>(si), y, X);
+            if (!CheapPlace(r, o, id, s.grasp[r])) continue;
+            TaskAction a;
+            a.type = ActionType::kPlace;
+            a.r1 = static_cast<int8_t>(r);
+            a.obj = static_cast<int16_t>(o);
+            a.loc = id;
+            push(a);
+          }
+        }
+      }
+    }
+  }
+  // Assemble.
+  if (!done && s.loc[m.moved] == kInAir && s.NumHolders(m.moved) >= 1 &&
+      (s.loc[m.base] >= 0 || s.NumHolders(m.base) >= 1) && CheapAssemble(s, m)) {
+    TaskAction a;
+    a.type = ActionType::kAssemble;
+    a.obj = static_cast<int16_t>(m.step);
+    push(a);
+  }
+}
+
+TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milestone& m,
+                                               const Resolution& res, int effort,
+                                               const std::set<std::uint64_t>& excluded,
+                                               std::vector<int>& path) {
+  nodes_.clear();
+  std::unordered_map<std::uint64_t, int> best_g;
+  using Entry = std::tuple<int, int, long long, int>;  // f, -g, sequence, node
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+  long long sequence = 0;
+  nodes_.push_back({s0, 0, -1, {}});
+  best_g[s0.Hash()] = 0;
+  open.push({kWeight * Heuristic(s0, m), 0, sequence++, 0});
+  std::vector<std::pair<TaskAction, SymState>> successors;
+  while (!open.empty()) {
+    if ((++expansions_ & 127) == 0 && ctx_.ShouldStop()) return SearchStatus::kStopped;
+    const auto [f, neg_g, seq, index] = open.top();
+    open.pop();
+    const int g = nodes_[index].g;
+    const std::uint64_t h = nodes_[index].s.Hash();
+    if (best_g[h] < g) continue;
+    if (IsGoal(nodes_[index].s, m, excluded)) {
+      path.clear();
+      for (int i = index; i > 0; i = nodes_[i].parent) path.push_back(i);
+      std::reverse(path.begin(), path.end());
+      return SearchStatus::kFound;
+    }
+    if (static_cast<long long>(nodes_.size()) > options_.max_nodes) return SearchStatus::kNodeLimit;
+    const SymState s = nodes_[index].s;
+    Successors(s, m, res, successors);
+    for (auto& [a, s2] : successors) {
+      auto failed = failed_level_.find(EdgeKey(s, a));
+      if (failed != failed_level_.end() && failed->second >= effort) continue;
+      const int g2 = g + 1;
+      const std::uint64_t h2 = s2.Hash();
+      auto [it, inserted] = best_g.try_emplace(h2, g2);
+      if (!inserted) {
+        if (it->second <= g2) continue;
+        it->second = g2;
+      }
+      const int child = static_cast<int>(nodes_.size());
+      nodes_.push_back({std::move(s2), g2, index, a});
+      open.push({g2 + kWeight * Heuristic(nodes_[child].s, m), -g2, sequence++, child});
+    }
+  }
+  return SearchStatus::kExhausted;
+}
+
+PlanAction TaskSearch::MakeAction(const SymState& s, const TaskAction& a, const EdgeOutcome& e,
+                                  int milestone) const {
+  PlanAction p;
+  p.type = a.type;
+  p.milestone = milestone;
+  p.keyframe = e.keyframe;
+  p.approach = e.approach;
+  auto hold = [&](int robot, int grasp_id) {
+    const GraspRef& g = tables_.grasp(grasp_id);
+    PlanHold h;
+    h.robot = robot;
+    h.grasp.subassembly = g.subassembly;
+    h.grasp.index = g.index;
+    h.grasp.part = g.part;
+    h.grasp.X_PG = g.X_PG;
+    h.grasp.width_m = g.width_m;
+    return h;
+  };
+  switch (a.type) {
+    case ActionType::kPick:
+    case ActionType::kAddGrasp:
+      p.robots = {a.r1};
+      p.objects = {a.obj};
+      p.grasps = {hold(a.r1, a.grasp)};
+      break;
+    case ActionType::kPlace: {
+      p.robots = {a.r1};
+      p.objects = {a.obj};
+      p.grasps = {hold(a.r1, s.grasp[a.r1])};
+      p.placement = tables_.location(a.loc).placement;
+      break;
+    }
+    case ActionType::kRelease:
+      p.robots = {a.r1};
+      p.objects = {a.obj};
+      p.grasps = {hold(a.r1, s.grasp[a.r1])};
+      break;
+    case ActionType::kHandover:
+      p.robots = {a.r1, a.r2};
+      p.objects = {a.obj};
+      p.grasps = {hold(a.r1, s.grasp[a.r1]), hold(a.r2, a.grasp)};
+      break;
+    case ActionType::kAssemble: {
+      const StepInterface& st = world_.interface(a.obj);
+      p.objects = {st.moved, st.base, a.obj};
+      for (int node : {st.moved, st.base}) {
+        for (int r = 0; r < n_robots_; ++r) {
+          if (s.held[r] == node) {
+            p.robots.push_back(r);
+            p.grasps.push_back(hold(r, s.grasp[r]));
+          }
+        }
+      }
+      break;
+    }
+  }
+  return p;
+}
+
+MilestoneResult TaskSearch::Fill(int index, int step, bool final, const SymState& s0,
+                                 const ContState& c0, const std::set<std::uint64_t>& excluded) {
+  const auto start = Clock::now();
+  const double ik_lp_before = 0.0;
+  (void)ik_lp_before;
+  Milestone m;
+  m.step = step;
+  m.moved = world_.interface(step).moved;
+  m.base = world_.interface(step).base;
+  m.final = final;
+  tally_ = GateTally{};
+  MilestoneResult result;
+  long long milestone_expansions = expansions_;
+  const int levels = 3;
+  std::vector<int> path;
+  for (int level = 0; level < levels; ++level) {
+    const Resolution res = ResolutionAt(level);
+    for (int effort = 0; effort <= options_.max_effort; ++effort) {
+      bool suspended_below = false;  // an edge that failed at this effort could be retried
+      while (true) {
+        const SearchStatus status = BestFirst(s0, m, res, effort, excluded, path);
+        if (status == SearchStatus::kStopped) {
+          result.stopped = true;
+          result.failure = "stopped";
+          return result;
+        }
+        if (status != SearchStatus::kFound) break;
+        // Validate the candidate plan edge by edge from the start.
+        SymState s = s0;
+        ContState c = c0;
+        std::vector<PlanAction> actions;
+        bool valid = true;
+        for (int node_index : path) {
+          if (ctx_.ShouldStop()) {
+            result.stopped = true;
+            result.failure = "stopped";
+            return result;
+          }
+          const TaskAction a = nodes_[node_index].a;
+          const SymState next = nodes_[node_index].s;
+          const std::uint64_t edge = EdgeKey(s, a);
+          const std::uint64_t witness_key = HashMix(c.Fingerprint(s), a.Hash());
+          auto w = witnesses_.find(witness_key);
+          if (w == witnesses_.end()) {
+            auto failed = failed_level_.find(edge);
+            const int edge_level = failed == failed_level_.end() ? 0 : failed->second + 1;
+            EdgeOutcome outcome =
+                solver_.Validate(s, c, a, next, edge_level, HashMix(seed_, edge));
+            if (!outcome.ok) {
+              tally_.Add(outcome.gate, outcome.message);
+              failed_level_[edge] = outcome.permanent ? kPermanent : edge_level;
+              if (!outcome.permanent && edge_level < options_.max_effort) suspended_below = true;
+              valid = false;
+              break;
+            }
+            w = witnesses_.emplace(witness_key, std::move(outcome)).first;
+          }
+          actions.push_back(MakeAction(s, a, w->second, index));
+          s = next;
+          c = w->second.next;
+        }
+        if (valid) {
+          result.ok = true;
+          result.actions = std::move(actions);
+          result.end = s;
+          result.end_c = c;
+          search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
+          return result;
+        }
+      }
+      if (!suspended_below) break;  // more effort would search the same graph
+    }
+    if (level + 1 < levels) ++widenings_;
+  }
+  search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
+  (void)milestone_expansions;
+  const StepInterface& st = world_.interface(step);
+  result.failure = "milestone " + std::to_string(index + 1) + " '" + world_.tree->nodes[step].name +
+                   "' (moving '" + world_.tree->nodes[st.moved].name + "' onto '" +
+                   world_.tree->nodes[st.base].name +
+                   "'): no plan with every grasp, placement and effort level; " + tally_.Summary();
+  return result;
+}
+
+}  // namespace wrap

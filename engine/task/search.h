@@ -1,0 +1,114 @@
+// The milestone fill of the task planner (paper Alg. 2 with the counting heuristic): a lazy
+// weighted best-first search over the symbolic state of one assembly step, edges validated by
+// the KeyframeSolver only on the best candidate plan, effort levels for suspended edges and
+// widening of the grasp and placement subsets.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <set>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "core/run_context.h"
+#include "task/keyframes.h"
+#include "task/planner.h"
+#include "task/state.h"
+#include "task/world.h"
+
+namespace wrap {
+
+/// Why edges failed within one milestone, for the report.
+struct GateTally {
+  std::array<long long, kNumGates> count{};
+  std::array<std::string, kNumGates> example;
+  void Add(Gate gate, const std::string& message);
+  /// e.g. "wrench (assembly) 120x (e.g. ...), IK 40x (...)".
+  std::string Summary(int max_gates = 3) const;
+};
+
+/// One milestone's answer.
+struct MilestoneResult {
+  bool ok = false;
+  bool stopped = false;              ///< Cancelled or out of time.
+  std::vector<PlanAction> actions;   ///< The validated actions.
+  SymState end;                      ///< Symbolic state at its end.
+  ContState end_c;                   ///< Continuous state at its end.
+  std::string failure;               ///< Why not, when !ok.
+};
+
+/// The lazy search of the task planner.
+class TaskSearch {
+ public:
+  TaskSearch(const TaskWorld& world, TaskTables& tables, KeyframeSolver& solver,
+             const TaskPlannerOptions& options, RunContext& ctx, std::uint64_t seed, bool widen);
+
+  /// Plans milestone `index` (step node `step`); `final` also asks every robot to be free at the
+  /// end. End states whose hash is in `excluded` do not count as goals (backtracking).
+  MilestoneResult Fill(int index, int step, bool final, const SymState& s0, const ContState& c0,
+                       const std::set<std::uint64_t>& excluded);
+
+  long long expansions() const { return expansions_; }
+  int widenings() const { return widenings_; }
+  double search_seconds() const { return search_s_; }
+
+ private:
+  struct Resolution {
+    int grasps = 0;
+    int placements = 0;
+    int slots = 0;
+    int yaws = 0;
+  };
+  struct Milestone {
+    int step = -1;
+    int moved = -1;
+    int base = -1;
+    bool final = false;
+  };
+  struct Node {
+    SymState s;
+    int g = 0;
+    int parent = -1;
+    TaskAction a;
+  };
+  enum class SearchStatus { kFound, kExhausted, kNodeLimit, kStopped };
+
+  Resolution ResolutionAt(int level) const;
+  const std::vector<int>& GraspIds(int node, int robot);
+  int Heuristic(const SymState& s, const Milestone& m) const;
+  bool IsGoal(const SymState& s, const Milestone& m, const std::set<std::uint64_t>& excluded) const;
+  void Successors(const SymState& s, const Milestone& m, const Resolution& res,
+                  std::vector<std::pair<TaskAction, SymState>>& out);
+  SymState Apply(const SymState& s, const TaskAction& a) const;
+  SearchStatus BestFirst(const SymState& s0, const Milestone& m, const Resolution& res, int effort,
+                         const std::set<std::uint64_t>& excluded, std::vector<int>& path);
+  bool CheapPick(int robot, int node, int loc, int grasp);
+  bool CheapPlace(int robot, int node, int loc, int grasp);
+  bool CheapAssemble(const SymState& s, const Milestone& m);
+  bool GraspsApart(int grasp_a, int grasp_b) const;
+  PlanAction MakeAction(const SymState& s, const TaskAction& a, const EdgeOutcome& e,
+                        int milestone) const;
+
+  const TaskWorld& world_;
+  TaskTables& tables_;
+  KeyframeSolver& solver_;
+  const TaskPlannerOptions& options_;
+  RunContext& ctx_;
+  std::uint64_t seed_;
+  bool widen_;
+  int n_robots_ = 0;
+  std::vector<Node> nodes_;
+  std::map<std::pair<int, int>, std::vector<int>> grasp_ids_;
+  std::unordered_map<std::uint64_t, int> failed_level_;   // edge key -> level failed at
+  std::unordered_map<std::uint64_t, EdgeOutcome> witnesses_;  // continuous edge key -> outcome
+  std::unordered_map<std::uint64_t, bool> cheap_;         // cheap-check answers
+  std::vector<Iso3> placement_pose_;                       // scratch
+  long long expansions_ = 0;
+  int widenings_ = 0;
+  double search_s_ = 0.0;
+  GateTally tally_;
+};
+
+}  // namespace wrap
