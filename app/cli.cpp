@@ -58,9 +58,10 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       "--frames", ren.frames,
       "With --plan: N frames (frame_NNN.png) evenly along the keyframes, frame k showing "
       "keyframe round(k*(K-1)/(N-1)) (keyframe index = time until plans are retimed)");
-  render->add_option("--at", ren.at,
-                     "With --plan: keyframe indices to draw, e.g. 0,3,7 (0 = initial; "
-                     "frame_NNN.png)")
+  render
+      ->add_option("--at", ren.at,
+                   "With --plan: keyframe indices to draw, e.g. 0,3,7 (0 = initial; "
+                   "frame_NNN.png)")
       ->excludes(frames);
   render->add_option("--size", ren.size, "Image size WIDTHxHEIGHT [px] (default 960x720)");
   render->add_option("--camera", ren.camera, "AZIMUTH,ELEVATION[,DISTANCE] [deg, deg, m]");

@@ -78,10 +78,9 @@ Result<std::vector<double>> ParseTimes(const std::string& text) {
   for (const std::string& p : Split(text, ',')) {
     double t = 0;
     if (!ParseNumber(p, t)) {
-      return Fail(
-          ErrorCode::kInvalidInput,
-          "--at '" + text +
-              "': expected keyframe indices of the plan separated by commas, e.g. 0,3,7");
+      return Fail(ErrorCode::kInvalidInput,
+                  "--at '" + text +
+                      "': expected keyframe indices of the plan separated by commas, e.g. 0,3,7");
     }
     times.push_back(t);
   }
@@ -180,8 +179,8 @@ int Render(const RenderArgs& args, std::ostream& out, std::ostream& err) {
     auto shots = render::PlanShots(*scene, *loaded.check.tree, *plan, options);
     if (!shots) return Report(shots.error(), err);
     job.shots = std::move(*shots);
-    job.title = scene->name + ": plan of " + std::to_string(plan->actions.size()) + " actions" +
-                (plan->stats.planner.empty() ? "" : " (" + plan->stats.planner + ")");
+    const size_t n = plan->actions.size();
+    job.title = scene->name + ": " + std::to_string(n) + (n == 1 ? " action" : " actions");
   } else {
     render::StillShotOptions still;
     still.initial = !args.goal;

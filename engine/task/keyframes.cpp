@@ -1,6 +1,8 @@
 #include "task/keyframes.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -35,6 +37,7 @@ constexpr int kAssemblySamples[] = {10, 25, 60};
 constexpr int kNumericRestarts[] = {3, 10, 25};
 constexpr int kMaxLeaves = 24;           // IK combinations tried per pose candidate
 constexpr int kMaxSolutionsPerRobot = 8;
+constexpr double kTouchTolerance = 2e-3;  // an object this close above the table rests on it
 
 }  // namespace
 
@@ -69,6 +72,56 @@ KeyframeSolver::KeyframeSolver(const TaskWorld& world, TaskTables& tables,
     frames_[r].resize(world.robots[r].chain.links.size());
   }
   part_object_.assign(world.num_parts, -1);
+  // Finger boxes as bodies of their own, so that each keyframe opens them to its grasp.
+  fingers_.resize(world.robots.size());
+  opening_.assign(world.robots.size(), 0.0);
+  CollisionWorld& w = cell_.world();
+  for (size_t r = 0; r < world.robots.size(); ++r) {
+    const EndEffector& ee = world.robots[r].end_effector;
+    if (ee.kind != EndEffectorKind::kTwoFinger || ee.finger_shapes[0] < 0) continue;
+    const std::vector<Shape> closed = EndEffectorShapesAt(ee, 0.0);
+    const std::vector<Shape> open = EndEffectorShapesAt(ee, ee.stroke_m);
+    Fingers f;
+    f.stroke = ee.stroke_m;
+    for (int k = 0; k < 2; ++k) {
+      const Shape& shape = closed[ee.finger_shapes[k]];
+      f.X_FS0[k] = shape.X_LS;
+      f.per_metre[k] = Vec3::Zero();
+      if (ee.stroke_m > 0.0) {
+        f.per_metre[k] = (open[ee.finger_shapes[k]].X_LS.translation() -
+                          shape.X_LS.translation()) / ee.stroke_m;
+      }
+      Shape box = shape;
+      box.X_LS = Iso3::Identity();
+      auto body = w.AddBody(BodyDef{world.robots[r].name + "/finger_" + std::to_string(k),
+                                    CellEndEffectorGroup(static_cast<int>(r)), {box},
+                                    Iso3::Identity()});
+      if (!body) continue;
+      f.body[k] = *body;
+      w.SetAllowed(*body, cell_.end_effector_body(static_cast<int>(r)), true);
+      const int dof = world.robots[r].chain.dof();
+      w.SetAllowed(*body, cell_.link_body(static_cast<int>(r), dof), true);
+    }
+    if (!f.body[0].valid() || !f.body[1].valid()) continue;
+    w.SetAllowed(f.body[0], f.body[1], true);
+    fingers_[r] = f;
+    opening_[r] = ee.stroke_m;
+  }
+}
+
+double KeyframeSolver::GraspOpening(int grasp) const {
+  return tables_.grasp(grasp).width_m + 0.002;
+}
+
+void KeyframeSolver::PlaceFingers(int robot, const Iso3& X_WF) {
+  if (!fingers_[robot]) return;
+  const Fingers& f = *fingers_[robot];
+  const double o = std::clamp(opening_[robot], 0.0, f.stroke);
+  for (int k = 0; k < 2; ++k) {
+    Iso3 X = f.X_FS0[k];
+    X.translation() += o * f.per_metre[k];
+    cell_.world().SetPose(f.body[k], X_WF * X);
+  }
 }
 
 Iso3 KeyframeSolver::GraspTarget(const Iso3& X_WA, int grasp_id) const {
@@ -81,16 +134,57 @@ bool KeyframeSolver::InReach(int robot, const Iso3& X_WT) const {
   return (X_WT.translation() - r.shoulder_W).norm() <= r.reach_m;
 }
 
-bool KeyframeSolver::ClearOfTable(int robot, const Iso3& X_WT) {
+bool KeyframeSolver::ClearOfTable(int robot, const Iso3& X_WT, double opening_m) {
   const TaskRobot& r = world_.robots[robot];
   const Iso3 X_WF = X_WT * r.end_effector.X_FT.inverse();
   CollisionWorld& w = cell_.world();
   const BodyId ee = cell_.end_effector_body(robot);
   const Iso3 saved = w.pose(ee);
+  const double saved_opening = opening_[robot];
   w.SetPose(ee, X_WF);
-  const bool hit = w.Collide(ee, cell_.table_body());
+  bool hit = w.Collide(ee, cell_.table_body());
+  if (fingers_[robot]) {
+    opening_[robot] = opening_m < 0.0 ? fingers_[robot]->stroke : opening_m;
+    PlaceFingers(robot, X_WF);
+    for (int k = 0; k < 2 && !hit; ++k) hit = w.Collide(fingers_[robot]->body[k], cell_.table_body());
+    opening_[robot] = saved_opening;
+    PlaceFingers(robot, saved);
+  }
   w.SetPose(ee, saved);
   return !hit;
+}
+
+bool KeyframeSolver::SoloReach(int robot, const std::vector<PlanObject>& objects, int grasp,
+                               std::string* why) {
+  const auto start = Clock::now();
+  const Iso3 target = GraspTarget(objects.front().X_WA, grasp);
+  std::mt19937_64 rng(HashMix(0x5010, static_cast<std::uint64_t>(grasp)));
+  std::vector<JointVector> sols;
+  const TaskRobot& r = world_.robots[robot];
+  bool ok = SolveIk(robot, target, r.home, r.ur ? 0 : 1, rng, sols);
+  if (!ok) {
+    if (why) *why = "no IK solution for '" + r.name + "' at grasp " +
+                    std::to_string(tables_.grasp(grasp).index);
+  } else {
+    SetScene(objects, {{robot, grasp}}, objects.size() > 1 ? objects[0].node : -1,
+             objects.size() > 1 ? objects[1].node : -1);
+    for (int q = 0; q < static_cast<int>(world_.robots.size()); ++q) EnableRobot(q, q == robot);
+    ok = false;
+    for (const JointVector& q : sols) {
+      SetRobot(robot, q);
+      if (!Collides()) {
+        ok = true;
+        break;
+      }
+    }
+    for (int q = 0; q < static_cast<int>(world_.robots.size()); ++q) EnableRobot(q, true);
+    if (!ok && why) {
+      *why = "every IK solution of '" + r.name + "' at grasp " +
+             std::to_string(tables_.grasp(grasp).index) + " collides (with the table or the part)";
+    }
+  }
+  counters_.t_ik_s += Seconds(start);
+  return ok;
 }
 
 bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objects,
@@ -180,6 +274,7 @@ bool KeyframeSolver::SolveIk(int robot, const Iso3& X_WT, const JointVector& ref
 void KeyframeSolver::SetRobot(int robot, const JointVector& q) {
   ForwardKinematics(world_.robots[robot].chain, world_.robots[robot].X_WB, q, frames_[robot]);
   cell_.SetConfiguration(robot, std::span<const double>(q.data(), q.size()), frames_[robot]);
+  PlaceFingers(robot, cell_.X_WF(robot));
 }
 
 void KeyframeSolver::EnableRobot(int robot, bool on) {
@@ -187,11 +282,19 @@ void KeyframeSolver::EnableRobot(int robot, bool on) {
   const int links = static_cast<int>(world_.robots[robot].chain.links.size());
   for (int i = 0; i < links; ++i) w.SetEnabled(cell_.link_body(robot, i), on);
   w.SetEnabled(cell_.end_effector_body(robot), on);
+  if (fingers_[robot]) {
+    for (int k = 0; k < 2; ++k) w.SetEnabled(fingers_[robot]->body[k], on);
+  }
 }
 
 bool KeyframeSolver::Collides() {
   ++counters_.collision_checks;
-  return cell_.InCollision();
+  static const bool debug = std::getenv("WRAP_TASK_DEBUG_COLLISIONS") != nullptr;
+  if (!debug) return cell_.InCollision();
+  CollisionResult result;
+  const bool hit = cell_.InCollision(&result);
+  if (hit) std::fprintf(stderr, "[task]     collision: %s\n", cell_.Describe(result.first).c_str());
+  return hit;
 }
 
 void KeyframeSolver::SetScene(const std::vector<PlanObject>& objects,
@@ -221,11 +324,25 @@ void KeyframeSolver::SetScene(const std::vector<PlanObject>& objects,
     }
     for (int r = 0; r < static_cast<int>(world_.robots.size()); ++r) {
       w.SetAllowed(cell_.end_effector_body(r), body, false);
+      if (fingers_[r]) {
+        for (int k = 0; k < 2; ++k) w.SetAllowed(fingers_[r]->body[k], body, false);
+      }
     }
   }
+  // Free grippers wait open; holding ones close to their grasp.
+  for (int r = 0; r < static_cast<int>(world_.robots.size()); ++r) {
+    if (fingers_[r]) opening_[r] = fingers_[r]->stroke;
+  }
   for (const auto& [robot, grasp] : holds) {
-    w.SetAllowed(cell_.end_effector_body(robot), cell_.object_body(tables_.grasp(grasp).part),
-                 true);
+    const BodyId part = cell_.object_body(tables_.grasp(grasp).part);
+    w.SetAllowed(cell_.end_effector_body(robot), part, true);
+    if (fingers_[robot]) {
+      opening_[robot] = GraspOpening(grasp);
+      for (int k = 0; k < 2; ++k) w.SetAllowed(fingers_[robot]->body[k], part, true);
+    }
+  }
+  for (int r = 0; r < static_cast<int>(world_.robots.size()); ++r) {
+    if (fingers_[r]) PlaceFingers(r, cell_.X_WF(r));
   }
 }
 
@@ -461,13 +578,17 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
           X[B] = air_pose(B, R, centre, k > static_cast<int>(orientations->size()));
         }
         X[M] = X[B];
+        // A moved input that reaches down to the table top slides along it into a resting base.
+        keyframe_resting[M] =
+            b_rests && LowestPoint(world_, M, X[M]) <= world_.table_top + kTouchTolerance;
         if (!b_rests && !above_table(B, X[B])) return false;
         // The moved input must not reach under the table top.
         return LowestPoint(world_, M, X[M]) >= world_.table_top - 1e-3;
       };
       gates = [&, m_holders, b_holders, b_rests, M, B](const std::vector<Iso3>& X, Gate& g,
                                                        std::string& why) {
-        const WrenchObject objs[2] = {{M, X[M], false, m_holders}, {B, X[B], b_rests, b_holders}};
+        const WrenchObject objs[2] = {{M, X[M], keyframe_resting[M], m_holders},
+                                      {B, X[B], b_rests, b_holders}};
         std::uint64_t key = 0;
         if (b_rests) {
           key = HashMix(3, static_cast<std::uint64_t>(o));
@@ -549,7 +670,7 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
         all = false;
         break;
       }
-      if (!ClearOfTable(m.robot, target)) {
+      if (!ClearOfTable(m.robot, target, GraspOpening(m.grasp))) {
         note(Gate::kCollision, "the gripper of '" + world_.robots[m.robot].name +
                                    "' would be in the table at grasp " +
                                    std::to_string(tables_.grasp(m.grasp).index));

@@ -74,8 +74,15 @@ class KeyframeSolver {
 
   /// Cheap: the TCP pose is inside the robot's reach sphere.
   bool InReach(int robot, const Iso3& X_WT) const;
-  /// Cheap: robot's end effector with its TCP at X_WT does not hit the table.
-  bool ClearOfTable(int robot, const Iso3& X_WT);
+  /// The robot alone (the other robots taken out) reaches grasp `grasp` on objects[0] with some
+  /// IK solution that collides with nothing among `objects` and the table. Context-free, so the
+  /// search caches it: an action that fails here fails in every state.
+  bool SoloReach(int robot, const std::vector<PlanObject>& objects, int grasp, std::string* why);
+  /// Cheap: robot's end effector with its TCP at X_WT (fingers at `opening_m`, or fully open
+  /// when negative) does not hit the table.
+  bool ClearOfTable(int robot, const Iso3& X_WT, double opening_m = -1.0);
+  /// Finger opening of a robot holding with `grasp` (width plus clearance).
+  double GraspOpening(int grasp) const;
   /// The wrench gate for `objects` (cached by `key`, which must identify the question), with the
   /// reason when infeasible. Mode none: always true.
   bool Wrench(WrenchGate gate, std::span<const WrenchObject> objects, int mating_step,
@@ -118,6 +125,15 @@ class KeyframeSolver {
   WrenchChecker checker_;
   std::vector<std::vector<Iso3>> frames_;  // per robot scratch FK frames
   std::vector<int> part_object_;           // scratch: object index of each part in SetScene
+  struct Fingers {
+    BodyId body[2];
+    Iso3 X_FS0[2];       // finger box in the flange frame, closed
+    Vec3 per_metre[2];   // its translation per metre of opening
+    double stroke = 0.0;
+  };
+  std::vector<std::optional<Fingers>> fingers_;  // per robot (two-finger grippers)
+  std::vector<double> opening_;                  // per robot: current finger opening
+  void PlaceFingers(int robot, const Iso3& X_WF);
 };
 
 }  // namespace wrap

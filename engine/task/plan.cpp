@@ -82,8 +82,8 @@ std::string DescribeAction(const Plan& plan, const PlanAction& action) {
       std::string words = r0 + " places " + o + " on the table";
       if (action.placement) {
         const PlanPlacement& p = *action.placement;
-        words += " (placement " + std::to_string(p.placement) + ", slot " +
-                 std::to_string(p.slot) + ", yaw " + std::to_string(p.yaw) + ")";
+        words += " (placement " + std::to_string(p.placement) + ", slot " + std::to_string(p.slot) +
+                 ", yaw " + std::to_string(p.yaw) + ")";
       }
       return words;
     }

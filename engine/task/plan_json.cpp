@@ -1,5 +1,6 @@
 #include "task/plan_json.h"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <initializer_list>
@@ -46,9 +47,8 @@ ojson KeyframeJson(const Plan& plan, const Keyframe& k) {
   }
   ojson objects = ojson::array();
   for (const PlanObject& o : k.objects) {
-    objects.push_back(ojson{{"name", NameOr(plan.nodes, o.node)},
-                            {"X_WA", PoseJson(o.X_WA)},
-                            {"resting", o.resting}});
+    objects.push_back(ojson{
+        {"name", NameOr(plan.nodes, o.node)}, {"X_WA", PoseJson(o.X_WA)}, {"resting", o.resting}});
   }
   return ojson{{"q", q}, {"objects", objects}};
 }
@@ -208,8 +208,8 @@ double NonNegative(const json& obj, const std::string& path, std::string_view ke
 
 long long IntegerValue(const json& j, const std::string& path, long long lo, long long hi) {
   if (!j.is_number_integer()) {
-    Bad(path, "expected an integer, found " +
-                  (j.is_number() ? std::string("a fraction") : TypeName(j)));
+    Bad(path,
+        "expected an integer, found " + (j.is_number() ? std::string("a fraction") : TypeName(j)));
   }
   const auto out_of_range = [&](const std::string& found) {
     Bad(path, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
@@ -421,8 +421,7 @@ class PlanReader {
                                   Int(*p, p_at, "yaw", 0)};
     }
     if (Find(j, "milestone")) {
-      a.milestone =
-          Int(j, at, "milestone", -1, static_cast<int>(plan_.milestone_steps.size()) - 1);
+      a.milestone = Int(j, at, "milestone", -1, static_cast<int>(plan_.milestone_steps.size()) - 1);
     }
     if (Find(j, "start_s")) a.start_s = NonNegative(j, at, "start_s");
     if (Find(j, "end_s")) a.end_s = NonNegative(j, at, "end_s");
@@ -463,10 +462,9 @@ class PlanReader {
                                   " robot(s), found " + std::to_string(a.robots.size()));
     }
     if (a.objects.size() != objects) {
-      Bad(Join(at, "objects"),
-          an + " action has " + std::to_string(objects) + " object(s)" +
-              (objects == 3 ? " (moved, base, result)" : "") + ", found " +
-              std::to_string(a.objects.size()));
+      Bad(Join(at, "objects"), an + " action has " + std::to_string(objects) + " object(s)" +
+                                   (objects == 3 ? " (moved, base, result)" : "") + ", found " +
+                                   std::to_string(a.objects.size()));
     }
   }
 
@@ -495,11 +493,12 @@ class PlanReader {
 
 PlanStats ReadStats(const json& root, const std::string& at) {
   const json& j = ExpectObject(Member(root, "", "stats"), at);
-  CheckKeys(j, at,
-            {"solved", "cost", "t_init_s", "planner", "seed", "t_grasp_s", "t_bwd_s", "t_lp_s",
-             "t_fwd_s", "t_ik_s", "wrench_mode", "force_scale", "grasps", "expansions",
-             "validations", "validation_failures", "lp_checks", "lp_cache_hits", "ik_calls",
-             "collision_checks", "milestones", "backtracks", "widenings", "failure"});
+  CheckKeys(j, at, {"solved",     "cost",          "t_init_s",    "planner",
+                    "seed",       "t_grasp_s",     "t_bwd_s",     "t_lp_s",
+                    "t_fwd_s",    "t_ik_s",        "wrench_mode", "force_scale",
+                    "grasps",     "expansions",    "validations", "validation_failures",
+                    "lp_checks",  "lp_cache_hits", "ik_calls",    "collision_checks",
+                    "milestones", "backtracks",    "widenings",   "failure"});
   PlanStats s;
   // Required: what DESIGN.md promises every plan file holds.
   s.solved = Bool(j, at, "solved");
@@ -546,7 +545,8 @@ PlanStats ReadStats(const json& root, const std::string& at) {
 }
 
 Plan ReadPlan(const json& root) {
-  if (!root.is_object()) Bad("", "expected a JSON object at the top level, found " + TypeName(root));
+  if (!root.is_object())
+    Bad("", "expected a JSON object at the top level, found " + TypeName(root));
   CheckKeys(root, "",
             {"format", "version", "project", "robots", "parts", "nodes", "milestones", "stats",
              "initial", "actions"});
@@ -556,8 +556,11 @@ Plan ReadPlan(const json& root) {
   }
   const json& version = Member(root, "", "version");
   if (!version.is_number_integer() || version.get<long long>() != kFormatVersion) {
+    // Not dump(): the value may be nested arbitrarily deep.
     Bad("version", "expected " + std::to_string(kFormatVersion) + " (the version this build " +
-                       "reads), found " + version.dump());
+                       "reads), found " +
+                       (version.is_number_integer() ? std::to_string(version.get<long long>())
+                                                    : TypeName(version)));
   }
 
   Plan plan;
@@ -566,9 +569,8 @@ Plan ReadPlan(const json& root) {
   plan.parts = Names(root, "", "parts", false);
   plan.nodes = Names(root, "", "nodes", false);
   if (plan.nodes.size() < plan.parts.size()) {
-    Bad("nodes", "expected the parts first, then the steps: " +
-                     std::to_string(plan.parts.size()) + " parts but only " +
-                     std::to_string(plan.nodes.size()) + " nodes");
+    Bad("nodes", "expected the parts first, then the steps: " + std::to_string(plan.parts.size()) +
+                     " parts but only " + std::to_string(plan.nodes.size()) + " nodes");
   }
   for (size_t i = 0; i < plan.parts.size(); ++i) {
     if (plan.nodes[i] != plan.parts[i]) {
@@ -626,18 +628,20 @@ Result<void> SameNames(const std::vector<std::string>& plan_names,
     }
     std::string problem;
     if (i >= plan_names.size()) {
-      problem = "the plan has no " + std::string(what) + " " + std::to_string(i) + ", the project "
-                "has '" + project_names[i] + "'";
+      problem = "the plan has no " + std::string(what) + " " + std::to_string(i) +
+                ", the project "
+                "has '" +
+                project_names[i] + "'";
     } else if (i >= project_names.size()) {
       problem = std::string(what) + " '" + plan_names[i] + "' is not in the project";
     } else {
       problem = "plan " + std::string(what) + " '" + plan_names[i] + "' where the project has '" +
                 project_names[i] + "'";
     }
-    return Fail(ErrorCode::kInvalidInput,
-                plan_file + ": " + Index(key, i) + ": " + problem + ": the plan is for other " +
-                    key + " (" + NameList(plan_names) + ") than project '" + project_name + "' (" +
-                    NameList(project_names) + ")");
+    return Fail(ErrorCode::kInvalidInput, plan_file + ": " + Index(key, i) + ": " + problem +
+                                              ": the plan is for other " + key + " (" +
+                                              NameList(plan_names) + ") than project '" +
+                                              project_name + "' (" + NameList(project_names) + ")");
   }
   return {};
 }
@@ -648,25 +652,24 @@ Result<void> CheckPartition(const Plan& plan, const Keyframe& k, const AssemblyT
   std::vector<int> owner(plan.parts.size(), -1);
   for (const PlanObject& o : k.objects) {
     if (o.node < 0 || o.node >= static_cast<int>(tree.nodes.size())) {
-      return Fail(ErrorCode::kInvalidInput, plan_file + ": " + Join(path, "objects") +
-                                                ": node " + std::to_string(o.node) +
-                                                " is not in the project");
+      return Fail(ErrorCode::kInvalidInput, plan_file + ": " + Join(path, "objects") + ": node " +
+                                                std::to_string(o.node) + " is not in the project");
     }
     for (int p : tree.nodes[o.node].parts) {
       if (p < 0 || p >= static_cast<int>(owner.size())) continue;
       if (owner[p] >= 0) {
-        return Fail(ErrorCode::kInvalidInput,
-                    plan_file + ": " + Join(path, "objects") + ": part '" + plan.parts[p] +
-                        "' is in both '" + plan.nodes[owner[p]] + "' and '" + plan.nodes[o.node] +
-                        "'");
+        return Fail(ErrorCode::kInvalidInput, plan_file + ": " + Join(path, "objects") +
+                                                  ": part '" + plan.parts[p] + "' is in both '" +
+                                                  plan.nodes[owner[p]] + "' and '" +
+                                                  plan.nodes[o.node] + "'");
       }
       owner[p] = o.node;
     }
   }
   for (size_t p = 0; p < owner.size(); ++p) {
     if (owner[p] < 0) {
-      return Fail(ErrorCode::kInvalidInput, plan_file + ": " + Join(path, "objects") +
-                                                ": part '" + plan.parts[p] +
+      return Fail(ErrorCode::kInvalidInput, plan_file + ": " + Join(path, "objects") + ": part '" +
+                                                plan.parts[p] +
                                                 "' is in no object (every part must be in one)");
     }
   }
@@ -677,18 +680,17 @@ Result<void> CheckKeyframe(const Plan& plan, const Keyframe& k, const AssemblyTr
                            const std::vector<int>& dof, const std::vector<std::string>& models,
                            const std::string& path, const std::string& plan_file) {
   if (k.q.size() != plan.robots.size()) {
-    return Fail(ErrorCode::kInvalidInput,
-                plan_file + ": " + Join(path, "q") + ": expected joint values of " +
-                    std::to_string(plan.robots.size()) + " robots, found " +
-                    std::to_string(k.q.size()));
+    return Fail(ErrorCode::kInvalidInput, plan_file + ": " + Join(path, "q") +
+                                              ": expected joint values of " +
+                                              std::to_string(plan.robots.size()) +
+                                              " robots, found " + std::to_string(k.q.size()));
   }
   for (size_t r = 0; r < k.q.size(); ++r) {
     if (dof[r] < 0 || k.q[r].size() == dof[r]) continue;
     return Fail(ErrorCode::kInvalidInput,
                 plan_file + ": " + Join(Join(path, "q"), plan.robots[r]) + ": expected " +
-                    std::to_string(dof[r]) + " numbers (robot model '" + models[r] +
-                    "' has " + std::to_string(dof[r]) + " joints), found " +
-                    std::to_string(k.q[r].size()));
+                    std::to_string(dof[r]) + " numbers (robot model '" + models[r] + "' has " +
+                    std::to_string(dof[r]) + " joints), found " + std::to_string(k.q[r].size()));
   }
   return CheckPartition(plan, k, tree, path, plan_file);
 }
@@ -834,14 +836,14 @@ Result<void> CheckPlanMatchesProject(const Plan& plan, const Project& project,
     if (a.milestone < -1 || a.milestone >= static_cast<int>(plan.milestone_steps.size())) {
       return bad(Join(at, "milestone"), "milestone index out of range");
     }
-    if (auto ok = CheckKeyframe(plan, a.keyframe, tree, dof, models, Join(at, "keyframe"),
-                                plan_file);
+    if (auto ok =
+            CheckKeyframe(plan, a.keyframe, tree, dof, models, Join(at, "keyframe"), plan_file);
         !ok) {
       return ok;
     }
     if (a.approach) {
-      if (auto ok = CheckKeyframe(plan, *a.approach, tree, dof, models, Join(at, "approach"),
-                                  plan_file);
+      if (auto ok =
+              CheckKeyframe(plan, *a.approach, tree, dof, models, Join(at, "approach"), plan_file);
           !ok) {
         return ok;
       }

@@ -90,6 +90,30 @@ Mat3 FrameWithZ(const Vec3& axis) {
   return R;
 }
 
+// The part of the convex counter-clockwise polygon `poly` inside the rectangle [lo, hi]
+// (Sutherland-Hodgman, one rectangle side at a time).
+std::vector<Eigen::Vector2d> ClipToRectangle(std::vector<Eigen::Vector2d> poly,
+                                             const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
+  for (int side = 0; side < 4 && !poly.empty(); ++side) {
+    const int axis = side % 2;
+    const double bound = side < 2 ? lo[axis] : hi[axis];
+    const double sign = side < 2 ? 1.0 : -1.0;  // inside: sign * (x - bound) >= 0
+    auto inside = [&](const Eigen::Vector2d& v) { return sign * (v[axis] - bound) >= 0.0; };
+    std::vector<Eigen::Vector2d> out;
+    for (size_t k = 0; k < poly.size(); ++k) {
+      const Eigen::Vector2d& a = poly[k];
+      const Eigen::Vector2d& b = poly[(k + 1) % poly.size()];
+      if (inside(a)) out.push_back(a);
+      if (inside(a) != inside(b)) {
+        const double t = (bound - a[axis]) / (b[axis] - a[axis]);
+        out.push_back(a + t * (b - a));
+      }
+    }
+    poly = std::move(out);
+  }
+  return poly;
+}
+
 // A robot as the validator sees it.
 struct RobotModel {
   std::string name;
@@ -166,6 +190,9 @@ class Validator {
   std::map<int, Iso3> CheckKeyframe(int index, const std::string& label, const Keyframe& kf,
                                     const Moment& m);
   void CheckRest(int index, const std::string& label, int node, const Iso3& X_WA);
+  // Where part p at X_WP touches the table: the convex hull of its vertices within the table
+  // tolerance of the top, clipped to the table's rectangle (a part may overhang the edge).
+  std::vector<Eigen::Vector2d> SupportPolygon(int part, const Iso3& X_WP) const;
   void CheckCollisions(int index, const std::string& label, const Keyframe& kf, const Moment& m,
                        const std::map<int, Iso3>& X_WA,
                        const std::vector<std::pair<int, PlanHold>>& holds);
@@ -183,10 +210,10 @@ class Validator {
   const PlanValidationOptions& options_;
 
   std::vector<RobotModel> robots_;
-  std::vector<Iso3> X_AP_;                  // per part
-  std::vector<std::vector<Vec3>> hull_P_;   // per part: hull (or mesh) vertices in P
-  std::vector<Aabb> box_A_;                 // per part: box in A
-  std::vector<Interface> interfaces_;       // per node (valid for steps)
+  std::vector<Iso3> X_AP_;                 // per part
+  std::vector<std::vector<Vec3>> hull_P_;  // per part: hull (or mesh) vertices in P
+  std::vector<Aabb> box_A_;                // per part: box in A
+  std::vector<Interface> interfaces_;      // per node (valid for steps)
   std::map<std::vector<long long>, Cell> cells_;
   bool cells_failed_ = false;
   std::optional<WrenchChecker> checker_;
@@ -194,9 +221,9 @@ class Validator {
   // The replayed state.
   std::map<int, ObjectState> objects_;
   std::vector<JointVector> q_;
-  std::vector<int> holding_;     // node held by each robot, -1 when free
-  std::vector<char> may_move_;   // freed by the last action: may park anywhere at the next keyframe
-  std::set<int> freed_now_;      // robots freed by the action being replayed
+  std::vector<int> holding_;    // node held by each robot, -1 when free
+  std::vector<char> may_move_;  // freed by the last action: may park anywhere at the next keyframe
+  std::set<int> freed_now_;     // robots freed by the action being replayed
 
   PlanValidation out_;
 };
@@ -333,13 +360,17 @@ Result<void> Validator::CheckInterpretable() const {
         return fail(where, "object node " + std::to_string(o.node) + " out of range (the DAG has " +
                                std::to_string(n_nodes) + " nodes)");
       }
+      if (!o.X_WA.matrix().allFinite()) {
+        return fail(where, "object " + Quote(tree_.nodes[o.node].name) + " has a non-finite pose");
+      }
     }
     return {};
   };
   if (auto ok = keyframe("initial keyframe", plan_.initial); !ok) return ok;
   for (size_t i = 0; i < plan_.actions.size(); ++i) {
     const PlanAction& a = plan_.actions[i];
-    const std::string where = "action " + std::to_string(i) + " (" + std::string(ToString(a.type)) + ")";
+    const std::string where =
+        "action " + std::to_string(i) + " (" + std::string(ToString(a.type)) + ")";
     for (int r : a.robots) {
       if (r < 0 || r >= n_robots) {
         return fail(where, "robot index " + std::to_string(r) + " out of range (the project has " +
@@ -354,6 +385,10 @@ Result<void> Validator::CheckInterpretable() const {
         return fail(where, "grasp part index " + std::to_string(h.grasp.part) +
                                " out of range (the project has " + std::to_string(n_parts) +
                                " parts)");
+      }
+      if (!h.grasp.X_PG.matrix().allFinite() || !std::isfinite(h.grasp.width_m)) {
+        return fail(where, "the grasp of robot " + Quote(robots_[h.robot].name) +
+                               " has a non-finite pose or width");
       }
     }
     for (int o : a.objects) {
@@ -375,25 +410,28 @@ void Validator::CheckNames() {
                      const char* what) {
     if (in_plan.empty()) return;
     if (in_plan.size() != count) {
-      Issue(-1, "plan", std::string("the plan names ") + std::to_string(in_plan.size()) + " " +
-                            what + ", the project has " + std::to_string(count));
+      Issue(-1, "plan",
+            std::string("the plan names ") + std::to_string(in_plan.size()) + " " + what +
+                ", the project has " + std::to_string(count));
       return;
     }
     for (size_t i = 0; i < count; ++i) {
       if (in_plan[i] != name_of(i)) {
-        Issue(-1, "plan", std::string(what) + " " + std::to_string(i) + " is " +
-                              Quote(in_plan[i]) + " in the plan but " + Quote(name_of(i)) +
-                              " in the project");
+        Issue(-1, "plan",
+              std::string(what) + " " + std::to_string(i) + " is " + Quote(in_plan[i]) +
+                  " in the plan but " + Quote(name_of(i)) + " in the project");
         return;
       }
     }
   };
-  compare(plan_.robots, [&](size_t i) { return project_.robots[i].name; }, project_.robots.size(),
-          "robots");
-  compare(plan_.parts, [&](size_t i) { return project_.parts[i].name; }, project_.parts.size(),
-          "parts");
-  compare(plan_.nodes, [&](size_t i) { return tree_.nodes[i].name; }, tree_.nodes.size(),
-          "nodes");
+  compare(
+      plan_.robots, [&](size_t i) { return project_.robots[i].name; }, project_.robots.size(),
+      "robots");
+  compare(
+      plan_.parts, [&](size_t i) { return project_.parts[i].name; }, project_.parts.size(),
+      "parts");
+  compare(
+      plan_.nodes, [&](size_t i) { return tree_.nodes[i].name; }, tree_.nodes.size(), "nodes");
 }
 
 const PlanHold* Validator::HoldOf(int node, int robot) const {
@@ -443,29 +481,38 @@ void Validator::Detach(int robot) {
   }
 }
 
+std::vector<Eigen::Vector2d> Validator::SupportPolygon(int part, const Iso3& X_WP) const {
+  const Table& t = project_.table;
+  std::vector<Eigen::Vector2d> xy;
+  for (const Vec3& v : hull_P_[part]) {
+    const Vec3 p_W = X_WP * v;
+    if (std::abs(p_W.z() - t.height) <= options_.table_tolerance_m) xy.push_back(p_W.head<2>());
+  }
+  if (xy.empty()) return {};
+  std::vector<Eigen::Vector2d> hull;
+  for (int k : ConvexHull2d(xy)) hull.push_back(xy[k]);
+  const Eigen::Vector2d half = 0.5 * t.size.head<2>();
+  return ClipToRectangle(std::move(hull), t.center_xy.head<2>() - half,
+                         t.center_xy.head<2>() + half);
+}
+
 void Validator::CheckRest(int index, const std::string& label, int node, const Iso3& X_WA) {
   const Table& t = project_.table;
   double lowest = std::numeric_limits<double>::infinity();
-  bool off_table = false;
+  bool supported = false;
   for (int p : tree_.nodes[node].parts) {
     const Iso3 X_WP = X_WA * X_AP_[p];
-    for (const Vec3& v : hull_P_[p]) {
-      const Vec3 p_W = X_WP * v;
-      lowest = std::min(lowest, p_W.z());
-      if (std::abs(p_W.z() - t.height) <= options_.table_tolerance_m &&
-          (std::abs(p_W.x() - t.center_xy.x()) > 0.5 * t.size.x() + options_.table_tolerance_m ||
-           std::abs(p_W.y() - t.center_xy.y()) > 0.5 * t.size.y() + options_.table_tolerance_m)) {
-        off_table = true;
-      }
-    }
+    for (const Vec3& v : hull_P_[p]) lowest = std::min(lowest, (X_WP * v).z());
+    supported = supported || !SupportPolygon(p, X_WP).empty();
   }
   const double gap = lowest - t.height;
   if (std::abs(gap) > options_.table_tolerance_m) {
     Issue(index, "pose",
           label + Quote(NodeName(node)) + " should rest on the table, but its lowest point is " +
               Mm(std::abs(gap)) + (gap > 0 ? " above" : " below") + " the table top");
-  } else if (off_table) {
-    Issue(index, "pose", label + Quote(NodeName(node)) + " rests partly beyond the table's edge");
+  } else if (!supported) {
+    Issue(index, "pose",
+          label + Quote(NodeName(node)) + " should rest on the table, but it is beside it");
   }
 }
 
@@ -492,8 +539,8 @@ Cell* Validator::CellFor(const std::vector<double>& openings) {
   }
   def.table.present = true;
   def.table.size = project_.table.size;
-  def.table.top_center = Vec3(project_.table.center_xy.x(), project_.table.center_xy.y(),
-                              project_.table.height);
+  def.table.top_center =
+      Vec3(project_.table.center_xy.x(), project_.table.center_xy.y(), project_.table.height);
   CellOptions options;
   options.objects_touch_table = false;  // decided per keyframe
   auto cell = Cell::Build(def, options);
@@ -547,8 +594,8 @@ void Validator::CheckCollisions(int index, const std::string& label, const Keyfr
   for (int p = 0; p < n_parts; ++p) {
     cell->SetObjectEnabled(p, object_of[p] >= 0);
     for (int s = p + 1; s < n_parts; ++s) {
-      cell->SetObjectPairAllowed(p, s, object_of[p] >= 0 && object_of[s] >= 0 &&
-                                           pair_allowed(object_of[p], object_of[s]));
+      cell->SetObjectPairAllowed(
+          p, s, object_of[p] >= 0 && object_of[s] >= 0 && pair_allowed(object_of[p], object_of[s]));
     }
     for (int r = 0; r < n_robots; ++r) {
       world.SetAllowed(cell->object_body(p), cell->end_effector_body(r), held_part[r] == p);
@@ -634,7 +681,8 @@ std::map<int, Iso3> Validator::CheckKeyframe(int index, const std::string& label
   for (const auto& [node, state] : objects_) {
     auto it = listed.find(node);
     if (it == listed.end()) {
-      Issue(index, "pose", label + "the keyframe does not list the object " + Quote(NodeName(node)));
+      Issue(index, "pose",
+            label + "the keyframe does not list the object " + Quote(NodeName(node)));
       X_WA[node] = state.X_WA;
       continue;
     }
@@ -654,9 +702,10 @@ std::map<int, Iso3> Validator::CheckKeyframe(int index, const std::string& label
           e.rotation_rad > options_.rotation_tolerance_rad) {
         Issue(index, "pose",
               label + Quote(NodeName(node)) + " is " + Mm(e.position_m) + " / " +
-                  Deg(e.rotation_rad) + (initial ? " away from its initial pose in the project"
-                                                 : " away from where it was, but the action "
-                                                   "may not move it"));
+                  Deg(e.rotation_rad) +
+                  (initial ? " away from its initial pose in the project"
+                           : " away from where it was, but the action "
+                             "may not move it"));
       }
       // Keep the state's pose: small drifts must not add up over the plan.
       X_WA[node] = state.X_WA;
@@ -723,12 +772,12 @@ std::map<int, Iso3> Validator::CheckKeyframe(int index, const std::string& label
     const PoseError e = Difference(X_WG, X_WT);
     if (e.position_m > options_.position_tolerance_m ||
         e.rotation_rad > options_.rotation_tolerance_rad) {
+      const std::string of = node == h.grasp.part ? "" : " of " + Quote(NodeName(node));
       Issue(index, "fk",
-            label + "robot " + Quote(robot.name) + "'s TCP is " + Mm(e.position_m) + " / " +
+            label + "robot " + Quote(robot.name) + ": the TCP is " + Mm(e.position_m) + " / " +
                 Deg(e.rotation_rad) + " away from its grasp on " + Quote(PartName(h.grasp.part)) +
-                " of " + Quote(NodeName(node)) + " (allowed " +
-                Mm(options_.position_tolerance_m) + " / " + Deg(options_.rotation_tolerance_rad) +
-                ")");
+                of + " (allowed " + Mm(options_.position_tolerance_m) + " / " +
+                Deg(options_.rotation_tolerance_rad) + ")");
     }
   }
 
@@ -746,20 +795,12 @@ void Validator::AddObject(int node, const Iso3& X_WA, const std::vector<PlanHold
     config.bodies.push_back(
         {PartName(p), check_.parts[p].mass_kg, X_WP * check_.parts[p].mass_properties.com});
     if (!on_table) continue;
-    std::vector<Vec3> touching;
-    std::vector<Eigen::Vector2d> xy;
-    for (const Vec3& v : hull_P_[p]) {
-      const Vec3 p_W = X_WP * v;
-      if (std::abs(p_W.z() - t.height) <= options_.table_tolerance_m) {
-        touching.emplace_back(p_W.x(), p_W.y(), t.height);
-        xy.emplace_back(p_W.x(), p_W.y());
-      }
-    }
-    if (touching.empty()) continue;
+    const std::vector<Eigen::Vector2d> polygon = SupportPolygon(p, X_WP);
+    if (polygon.empty()) continue;
     WrenchTableSupport support;
     support.body = body_of_part[p];
     support.friction = t.friction;
-    for (int k : ConvexHull2d(xy)) support.p_WV.push_back(touching[k]);
+    for (const Eigen::Vector2d& v : polygon) support.p_WV.emplace_back(v.x(), v.y(), t.height);
     config.tables.push_back(std::move(support));
   }
   // Connections made by the steps inside the object.
@@ -785,8 +826,8 @@ void Validator::AddObject(int node, const Iso3& X_WA, const std::vector<PlanHold
     if (!NodeHasPart(node, h.grasp.part)) continue;
     const RobotModel& robot = robots_[h.robot];
     config.grippers.push_back(MakeGripper(robot.name, body_of_part[h.grasp.part],
-                                          X_WA * X_AP_[h.grasp.part] * h.grasp.X_PG,
-                                          robot.ee.kind, robot.limits));
+                                          X_WA * X_AP_[h.grasp.part] * h.grasp.X_PG, robot.ee.kind,
+                                          robot.limits));
   }
 }
 
@@ -874,13 +915,15 @@ void Validator::ReplayAction(int i) {
         Issue(i, "precondition", "pick: " + Quote(NodeName(o)) + " is in the air, not resting");
       }
       if (!obj.holders.empty()) {
-        Issue(i, "precondition", "pick: " + Quote(NodeName(o)) + " is already held by " +
-                                     Quote(RobotName(obj.holders[0].robot)));
+        Issue(i, "precondition",
+              "pick: " + Quote(NodeName(o)) + " is already held by " +
+                  Quote(RobotName(obj.holders[0].robot)));
       }
       RequireFree(i, r, "the picking robot");
       if (!NodeHasPart(o, g.grasp.part)) {
-        Issue(i, "precondition", "the grasp is on " + Quote(PartName(g.grasp.part)) +
-                                     ", which is not a part of " + Quote(NodeName(o)));
+        Issue(i, "precondition",
+              "the grasp is on " + Quote(PartName(g.grasp.part)) + ", which is not a part of " +
+                  Quote(NodeName(o)));
       }
       m.new_holds.emplace_back(o, g);
       X = CheckKeyframe(i, "", kf, m);
@@ -903,9 +946,10 @@ void Validator::ReplayAction(int i) {
         Issue(i, "precondition", "place: " + Quote(NodeName(o)) + " already rests on the table");
       }
       if (obj.holders.size() != 1 || obj.holders[0].robot != r) {
-        Issue(i, "precondition", "place: " + Quote(RobotName(r)) + " must be the only holder of " +
-                                     Quote(NodeName(o)) + " (it has " +
-                                     std::to_string(obj.holders.size()) + " holders)");
+        Issue(i, "precondition",
+              "place: " + Quote(RobotName(r)) + " must be the only holder of " +
+                  Quote(NodeName(o)) + " (it has " + std::to_string(obj.holders.size()) +
+                  " holders)");
       }
       GraspMatches(i, o, a.grasps[0]);
       m.moving.insert(o);
@@ -935,14 +979,16 @@ void Validator::ReplayAction(int i) {
         Issue(i, "precondition", "handover: " + Quote(NodeName(o)) + " rests on the table");
       }
       if (obj.holders.size() != 1 || obj.holders[0].robot != giver) {
-        Issue(i, "precondition", "handover: the giver " + Quote(RobotName(giver)) +
-                                     " must be the only holder of " + Quote(NodeName(o)));
+        Issue(i, "precondition",
+              "handover: the giver " + Quote(RobotName(giver)) + " must be the only holder of " +
+                  Quote(NodeName(o)));
       }
       GraspMatches(i, o, a.grasps[0]);
       RequireFree(i, receiver, "the receiver");
       if (!NodeHasPart(o, g2.grasp.part)) {
-        Issue(i, "precondition", "the receiver's grasp is on " + Quote(PartName(g2.grasp.part)) +
-                                     ", which is not a part of " + Quote(NodeName(o)));
+        Issue(i, "precondition",
+              "the receiver's grasp is on " + Quote(PartName(g2.grasp.part)) +
+                  ", which is not a part of " + Quote(NodeName(o)));
       }
       m.moving.insert(o);
       m.new_holds.emplace_back(o, g2);
@@ -952,8 +998,8 @@ void Validator::ReplayAction(int i) {
       AddObject(o, X.at(o), {g2}, false, config, body);
       RunGate(i, WrenchGate::kTransport, config,
               Quote(RobotName(receiver)) + " carrying " + Quote(NodeName(o)) + " alone");
-      const bool moved = Difference(objects_[o].X_WA, X.at(o)).position_m >
-                         options_.position_tolerance_m;
+      const bool moved =
+          Difference(objects_[o].X_WA, X.at(o)).position_m > options_.position_tolerance_m;
       for (const PlanHold& h : objects_[o].holders) {
         holding_[h.robot] = -1;
         freed_now_.insert(h.robot);
@@ -973,11 +1019,13 @@ void Validator::ReplayAction(int i) {
       ObjectState& obj = objects_[o];
       RequireFree(i, r, "the bracing robot");
       if (!obj.resting && obj.holders.empty()) {
-        Issue(i, "precondition", "add_grasp: " + Quote(NodeName(o)) + " is neither resting nor held");
+        Issue(i, "precondition",
+              "add_grasp: " + Quote(NodeName(o)) + " is neither resting nor held");
       }
       if (!NodeHasPart(o, g.grasp.part)) {
-        Issue(i, "precondition", "the grasp is on " + Quote(PartName(g.grasp.part)) +
-                                     ", which is not a part of " + Quote(NodeName(o)));
+        Issue(i, "precondition",
+              "the grasp is on " + Quote(PartName(g.grasp.part)) + ", which is not a part of " +
+                  Quote(NodeName(o)));
       }
       if (!obj.resting) m.moving.insert(o);
       m.new_holds.emplace_back(o, g);
@@ -1006,9 +1054,9 @@ void Validator::ReplayAction(int i) {
       ObjectState& obj = objects_[o];
       const bool holds = GraspMatches(i, o, a.grasps[0]) || HoldOf(o, r) != nullptr;
       if (holds && !obj.resting && obj.holders.size() < 2) {
-        Issue(i, "precondition", "release: " + Quote(NodeName(o)) +
-                                     " is in the air and " + Quote(RobotName(r)) +
-                                     " is its only holder: it would fall");
+        Issue(i, "precondition",
+              "release: " + Quote(NodeName(o)) + " is in the air and " + Quote(RobotName(r)) +
+                  " is its only holder: it would fall");
       }
       X = CheckKeyframe(i, "", kf, m);
       std::vector<PlanHold> remaining;
@@ -1036,8 +1084,9 @@ void Validator::ReplayAction(int i) {
       const int M = a.objects[0];
       const int B = a.objects[1];
       if (M == B) {
-        Issue(i, "precondition", "assemble: the moved and the base input are the same object " +
-                                     Quote(NodeName(M)) + "; the replay stops here");
+        Issue(i, "precondition",
+              "assemble: the moved and the base input are the same object " + Quote(NodeName(M)) +
+                  "; the replay stops here");
         return;
       }
       int S = -1;
@@ -1048,41 +1097,44 @@ void Validator::ReplayAction(int i) {
         }
       }
       if (S < 0) {
-        Issue(i, "precondition", "assemble: " + Quote(NodeName(M)) + " and " + Quote(NodeName(B)) +
-                                     " are not the two inputs of any assembly step; the replay "
-                                     "stops here");
+        Issue(i, "precondition",
+              "assemble: " + Quote(NodeName(M)) + " and " + Quote(NodeName(B)) +
+                  " are not the two inputs of any assembly step; the replay "
+                  "stops here");
         return;
       }
       if (a.objects[2] != S) {
-        Issue(i, "precondition", "assemble: joining " + Quote(NodeName(M)) + " and " +
-                                     Quote(NodeName(B)) + " builds " + Quote(NodeName(S)) +
-                                     ", not " + Quote(NodeName(a.objects[2])));
+        Issue(i, "precondition",
+              "assemble: joining " + Quote(NodeName(M)) + " and " + Quote(NodeName(B)) +
+                  " builds " + Quote(NodeName(S)) + ", not " + Quote(NodeName(a.objects[2])));
       }
       const Interface& f = interfaces_[S];
       if (f.moved_node != M) {
-        Issue(i, "precondition", "assemble: step " + Quote(NodeName(S)) + " moves " +
-                                     Quote(NodeName(f.moved_node)) + " onto " +
-                                     Quote(NodeName(f.base_node)) + ", the plan the other way");
+        Issue(i, "precondition",
+              "assemble: step " + Quote(NodeName(S)) + " moves " + Quote(NodeName(f.moved_node)) +
+                  " onto " + Quote(NodeName(f.base_node)) + ", the plan the other way");
       }
       const ObjectState& mo = objects_[M];
       const ObjectState& bo = objects_[B];
       if (mo.resting) {
-        Issue(i, "precondition", "assemble: the moved input " + Quote(NodeName(M)) +
-                                     " rests on the table; it must be held in the air");
+        Issue(i, "precondition",
+              "assemble: the moved input " + Quote(NodeName(M)) +
+                  " rests on the table; it must be held in the air");
       }
       if (mo.holders.empty()) {
         Issue(i, "precondition", "assemble: nothing holds the moved input " + Quote(NodeName(M)));
       }
       if (!bo.resting && bo.holders.empty()) {
-        Issue(i, "precondition", "assemble: the base input " + Quote(NodeName(B)) +
-                                     " is neither resting nor held");
+        Issue(i, "precondition",
+              "assemble: the base input " + Quote(NodeName(B)) + " is neither resting nor held");
       }
       std::set<int> expected, named(a.robots.begin(), a.robots.end());
       for (const PlanHold& h : mo.holders) expected.insert(h.robot);
       for (const PlanHold& h : bo.holders) expected.insert(h.robot);
       if (expected != named) {
-        Issue(i, "precondition", "assemble: the action's robots must be exactly those holding " +
-                                     Quote(NodeName(M)) + " or " + Quote(NodeName(B)));
+        Issue(i, "precondition",
+              "assemble: the action's robots must be exactly those holding " + Quote(NodeName(M)) +
+                  " or " + Quote(NodeName(B)));
       }
       for (const PlanHold& h : a.grasps) {
         if (holding_[h.robot] == M || holding_[h.robot] == B) GraspMatches(i, holding_[h.robot], h);
@@ -1103,8 +1155,8 @@ void Validator::ReplayAction(int i) {
         Iso3 X_WM_ap = X_WB;
         X_WM_ap.translation() -= f.step->mating.approach_m * (X_WB.linear() * f.axis_A);
         ap.required[M] = {X_WM_ap, "its approach pose (" + Mm(f.step->mating.approach_m) +
-                                       " back along the insertion axis from " +
-                                       Quote(NodeName(B)) + ")"};
+                                       " back along the insertion axis from " + Quote(NodeName(B)) +
+                                       ")"};
         if (base_moves) ap.required[B] = {X_WB, "its pose at the assemble keyframe"};
         CheckKeyframe(i, "approach: ", *a.approach, ap);
       } else {
@@ -1128,9 +1180,9 @@ void Validator::ReplayAction(int i) {
       ObjectState s;
       s.X_WA = X.at(B);
       s.resting = objects_[B].resting;
-      s.at_rest_pose = objects_[B].at_rest_pose &&
-                       Difference(objects_[B].X_WA, X.at(B)).position_m <=
-                           options_.position_tolerance_m;
+      s.at_rest_pose =
+          objects_[B].at_rest_pose &&
+          Difference(objects_[B].X_WA, X.at(B)).position_m <= options_.position_tolerance_m;
       s.holders = objects_[M].holders;
       s.holders.insert(s.holders.end(), objects_[B].holders.begin(), objects_[B].holders.end());
       objects_.erase(M);
@@ -1180,18 +1232,21 @@ PlanValidation Validator::Run() {
     const int root = tree_.root;
     if (objects_.size() != 1 || !objects_.count(root)) {
       std::string names;
-      for (const auto& [node, s] : objects_) names += (names.empty() ? "" : ", ") + Quote(NodeName(node));
-      Issue(last, "incomplete", "the plan ends with " + std::to_string(objects_.size()) +
-                                    " objects (" + names + "), not with the assembly " +
-                                    Quote(NodeName(root)) + " alone");
+      for (const auto& [node, s] : objects_)
+        names += (names.empty() ? "" : ", ") + Quote(NodeName(node));
+      Issue(last, "incomplete",
+            "the plan ends with " + std::to_string(objects_.size()) + " objects (" + names +
+                "), not with the assembly " + Quote(NodeName(root)) + " alone");
     } else if (!objects_.at(root).resting) {
-      Issue(last, "incomplete", "the plan ends with " + Quote(NodeName(root)) +
-                                    " in the air instead of resting on the table");
+      Issue(last, "incomplete",
+            "the plan ends with " + Quote(NodeName(root)) +
+                " in the air instead of resting on the table");
     }
     for (size_t r = 0; r < robots_.size(); ++r) {
       if (holding_[r] >= 0) {
-        Issue(last, "incomplete", "the plan ends with robot " + Quote(robots_[r].name) +
-                                      " still holding " + Quote(NodeName(holding_[r])));
+        Issue(last, "incomplete",
+              "the plan ends with robot " + Quote(robots_[r].name) + " still holding " +
+                  Quote(NodeName(holding_[r])));
       }
     }
   }

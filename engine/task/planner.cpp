@@ -93,7 +93,8 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
                      world.tree->nodes[order[k]].name + "'");
     const SymState& s = k == 0 ? s0 : results[k - 1].end;
     const ContState& c = k == 0 ? c0 : results[k - 1].end_c;
-    MilestoneResult r = search.Fill(k, order[k], k == K - 1, s, c, excluded[k]);
+    MilestoneResult r =
+        search.Fill(k, order[k], k + 1 < K ? order[k + 1] : -1, s, c, excluded[k]);
     if (r.ok) {
       results[k] = std::move(r);
       ++k;

@@ -1,6 +1,8 @@
 #include "task/search.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <chrono>
 #include <climits>
 #include <queue>
@@ -15,6 +17,12 @@ using Clock = std::chrono::steady_clock;
 
 constexpr int kPermanent = INT_MAX;
 constexpr int kWeight = 2;  // weighted best-first: f = g + 2 h
+// Node budget of a search from a committed state past the milestone's start: beyond it the
+// state counts as a dead end and the search backs up.
+constexpr long long kLocalNodes = 20000;
+// Validation failures after which the fill stops searching from the milestone's start and
+// commits to the validated prefix of its candidates.
+constexpr int kRootFailures = 40;
 
 std::uint64_t EdgeKey(const SymState& s, const TaskAction& a) {
   return HashMix(s.Hash(), a.Hash());
@@ -26,6 +34,17 @@ void GateTally::Add(Gate gate, const std::string& message) {
   const int i = static_cast<int>(gate);
   ++count[i];
   if (example[i].empty()) example[i] = message;
+  last_gate = gate;
+  last_message = message;
+}
+
+bool TaskSearch::Recall(const CheapAnswer& answer) {
+  if (!answer.ok) tally_.Add(answer.gate, answer.why);
+  return answer.ok;
+}
+
+void TaskSearch::Remember(std::uint64_t key, bool ok) {
+  cheap_[key] = ok ? CheapAnswer{} : CheapAnswer{false, tally_.last_gate, tally_.last_message};
 }
 
 std::string GateTally::Summary(int max_gates) const {
@@ -103,20 +122,18 @@ int TaskSearch::Heuristic(const SymState& s, const Milestone& m) const {
     m_needs_grasp = s.NumHolders(m.moved) == 0 || s.loc[m.moved] >= 0;
     if (m_needs_grasp) h += 1;
   }
-  if (m.final) {
-    for (int r = 0; r < n_robots_; ++r) h += s.held[r] >= 0;
-    if (m_needs_grasp) h += 1;
+  for (int r = 0; r < n_robots_; ++r) {
+    if (s.held[r] >= 0 && s.held[r] != m.keep[0] && s.held[r] != m.keep[1]) h += 1;
   }
+  if (m.final && m_needs_grasp) h += 1;
   return h;
 }
 
 bool TaskSearch::IsGoal(const SymState& s, const Milestone& m,
                         const std::set<std::uint64_t>& excluded) const {
   if (s.loc[m.step] == kInactive) return false;
-  if (m.final) {
-    for (int r = 0; r < n_robots_; ++r) {
-      if (s.held[r] >= 0) return false;
-    }
+  for (int r = 0; r < n_robots_; ++r) {
+    if (s.held[r] >= 0 && s.held[r] != m.keep[0] && s.held[r] != m.keep[1]) return false;
   }
   return excluded.empty() || !excluded.contains(s.Hash());
 }
@@ -168,11 +185,24 @@ SymState TaskSearch::Apply(const SymState& s, const TaskAction& a) const {
 
 bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
   std::uint64_t key = HashMix(HashMix(HashMix(HashMix(101, robot), node), loc), grasp);
-  auto it = cheap_.find(key);
-  if (it != cheap_.end()) return it->second;
+  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(it->second);
   const Iso3 X_WA = tables_.location(loc).X_WA;
   const Iso3 target = solver_.GraspTarget(X_WA, grasp);
-  bool ok = solver_.InReach(robot, target) && solver_.ClearOfTable(robot, target);
+  bool ok = solver_.InReach(robot, target);
+  if (!ok) tally_.Add(Gate::kReach, "'" + world_.robots[robot].name + "' cannot reach grasp " +
+                                        std::to_string(tables_.grasp(grasp).index) + " of '" +
+                                        world_.tree->nodes[node].name + "' where it rests");
+  if (ok && !solver_.ClearOfTable(robot, target, solver_.GraspOpening(grasp))) {
+    ok = false;
+    tally_.Add(Gate::kCollision, "grasp " + std::to_string(tables_.grasp(grasp).index) + " of '" +
+                                     world_.tree->nodes[node].name +
+                                     "' puts the gripper into the table where it rests");
+  }
+  if (ok) {
+    std::string why;
+    ok = solver_.SoloReach(robot, {{node, X_WA, true}}, grasp, &why);
+    if (!ok) tally_.Add(Gate::kIk, why + " where '" + world_.tree->nodes[node].name + "' rests");
+  }
   if (ok) {
     // Transport right after the lift: deterministic, so checked here.
     const WrenchObject obj{node, X_WA, false, {{robot, grasp}}};
@@ -182,24 +212,36 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
     ok = solver_.Wrench(WrenchGate::kTransport, {&obj, 1}, -1, lp_key, &why);
     if (!ok) tally_.Add(Gate::kWrenchTransport, why);
   }
-  cheap_[key] = ok;
+  Remember(key, ok);
   return ok;
 }
 
 bool TaskSearch::CheapPlace(int robot, int node, int loc, int grasp) {
   std::uint64_t key = HashMix(HashMix(HashMix(HashMix(102, robot), node), loc), grasp);
-  auto it = cheap_.find(key);
-  if (it != cheap_.end()) return it->second;
+  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(it->second);
   const Iso3 X_WA = tables_.location(loc).X_WA;
   const Iso3 target = solver_.GraspTarget(X_WA, grasp);
-  bool ok = solver_.InReach(robot, target) && solver_.ClearOfTable(robot, target);
+  bool ok = solver_.InReach(robot, target);
+  if (!ok) tally_.Add(Gate::kReach, "'" + world_.robots[robot].name + "' cannot reach to set '" +
+                                        world_.tree->nodes[node].name + "' down there");
+  if (ok && !solver_.ClearOfTable(robot, target, solver_.GraspOpening(grasp))) {
+    ok = false;
+    tally_.Add(Gate::kCollision, "setting '" + world_.tree->nodes[node].name + "' down with grasp " +
+                                     std::to_string(tables_.grasp(grasp).index) +
+                                     " puts the gripper into the table");
+  }
+  if (ok) {
+    std::string why;
+    ok = solver_.SoloReach(robot, {{node, X_WA, true}}, grasp, &why);
+    if (!ok) tally_.Add(Gate::kIk, why + " to set '" + world_.tree->nodes[node].name + "' down");
+  }
   if (ok) {
     const WrenchObject obj{node, X_WA, true, {}};
     std::string why;
     ok = solver_.Wrench(WrenchGate::kRest, {&obj, 1}, -1, HashMix(2, loc + 1), &why);
     if (!ok) tally_.Add(Gate::kWrenchRest, why);
   }
-  cheap_[key] = ok;
+  Remember(key, ok);
   return ok;
 }
 
@@ -215,19 +257,37 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
   for (const auto& [r, g] : mh) key = HashMix(HashMix(key, r), g);
   key = HashMix(key, 999);
   for (const auto& [r, g] : bh) key = HashMix(HashMix(key, r), g);
-  auto it = cheap_.find(key);
-  if (it != cheap_.end()) return it->second;
+  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(it->second);
   bool ok = true;
   std::string why;
   if (b_rests) {
     const Iso3 X_WB = tables_.location(s.loc[m.base]).X_WA;
     for (const auto& [r, g] : mh) {
       const Iso3 target = solver_.GraspTarget(X_WB, g);
-      if (!solver_.InReach(r, target) || !solver_.ClearOfTable(r, target)) ok = false;
+      if (!solver_.InReach(r, target) ||
+          !solver_.ClearOfTable(r, target, solver_.GraspOpening(g))) {
+        ok = false;
+        tally_.Add(Gate::kReach, "'" + world_.robots[r].name + "' cannot bring '" +
+                                     world_.tree->nodes[m.moved].name + "' to '" +
+                                     world_.tree->nodes[m.base].name + "' where it rests");
+      }
     }
-    if (ok && LowestPoint(world_, m.moved, X_WB) < world_.table_top - 1e-3) ok = false;
+    const bool m_touches = LowestPoint(world_, m.moved, X_WB) <= world_.table_top + 2e-3;
+    for (const auto& [r, g] : mh) {
+      if (!ok) break;
+      std::string why;
+      ok = solver_.SoloReach(r, {{m.moved, X_WB, m_touches}, {m.base, X_WB, true}}, g, &why);
+      if (!ok) tally_.Add(Gate::kIk, why + " to insert '" + world_.tree->nodes[m.moved].name + "'");
+    }
+    if (ok && LowestPoint(world_, m.moved, X_WB) < world_.table_top - 1e-3) {
+      ok = false;
+      tally_.Add(Gate::kTable, "'" + world_.tree->nodes[m.moved].name +
+                                   "' would go through the table to reach '" +
+                                   world_.tree->nodes[m.base].name + "' resting as it is");
+    }
     if (ok) {
-      const WrenchObject objs[2] = {{m.moved, X_WB, false, mh}, {m.base, X_WB, true, bh}};
+      const bool m_rests = LowestPoint(world_, m.moved, X_WB) <= world_.table_top + 2e-3;
+      const WrenchObject objs[2] = {{m.moved, X_WB, m_rests, mh}, {m.base, X_WB, true, bh}};
       std::uint64_t lp_key = HashMix(3, static_cast<std::uint64_t>(m.step));
       lp_key = HashMix(lp_key, static_cast<std::uint64_t>(s.loc[m.base]) + 7);
       for (const auto& [r, g] : mh) lp_key = HashMix(HashMix(lp_key, r), g);
@@ -240,7 +300,7 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
     ok = solver_.AirAssemblyPossible(m.step, mh, bh, key, &why);
     if (!ok) tally_.Add(Gate::kWrenchAssembly, why);
   }
-  cheap_[key] = ok;
+  Remember(key, ok);
   return ok;
 }
 
@@ -381,7 +441,8 @@ void TaskSearch::Successors(const SymState& s, const Milestone& m, const Resolut
 TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milestone& m,
                                                const Resolution& res, int effort,
                                                const std::set<std::uint64_t>& excluded,
-                                               std::vector<int>& path) {
+                                               const std::unordered_map<std::uint64_t, bool>& dead_ends,
+                                               long long node_budget, std::vector<int>& path) {
   nodes_.clear();
   std::unordered_map<std::uint64_t, int> best_g;
   using Entry = std::tuple<int, int, long long, int>;  // f, -g, sequence, node
@@ -404,12 +465,14 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milesto
       std::reverse(path.begin(), path.end());
       return SearchStatus::kFound;
     }
-    if (static_cast<long long>(nodes_.size()) > options_.max_nodes) return SearchStatus::kNodeLimit;
+    if (static_cast<long long>(nodes_.size()) > node_budget) return SearchStatus::kNodeLimit;
     const SymState s = nodes_[index].s;
     Successors(s, m, res, successors);
     for (auto& [a, s2] : successors) {
-      auto failed = failed_level_.find(EdgeKey(s, a));
+      const std::uint64_t edge = EdgeKey(s, a);
+      auto failed = failed_level_.find(edge);
       if (failed != failed_level_.end() && failed->second >= effort) continue;
+      if (!dead_ends.empty() && dead_ends.contains(edge)) continue;
       const int g2 = g + 1;
       const std::uint64_t h2 = s2.Hash();
       auto [it, inserted] = best_g.try_emplace(h2, g2);
@@ -484,37 +547,67 @@ PlanAction TaskSearch::MakeAction(const SymState& s, const TaskAction& a, const 
   return p;
 }
 
-MilestoneResult TaskSearch::Fill(int index, int step, bool final, const SymState& s0,
+MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymState& s0,
                                  const ContState& c0, const std::set<std::uint64_t>& excluded) {
   const auto start = Clock::now();
-  const double ik_lp_before = 0.0;
-  (void)ik_lp_before;
   Milestone m;
   m.step = step;
   m.moved = world_.interface(step).moved;
   m.base = world_.interface(step).base;
-  m.final = final;
+  m.final = next_step < 0;
+  // Objects robots may still hold at the end: the inputs of the next step (none at the end).
+  if (next_step >= 0) {
+    m.keep[0] = world_.interface(next_step).moved;
+    m.keep[1] = world_.interface(next_step).base;
+  }
   tally_ = GateTally{};
   MilestoneResult result;
-  long long milestone_expansions = expansions_;
   const int levels = 3;
   std::vector<int> path;
+  // The committed prefix: validated states from s0 on. The search starts from its last state;
+  // a candidate plan's validated edges are committed (greedy, like the paper's lazy greedy fill);
+  // when the search from a committed state finds nothing, that state is abandoned (its entering
+  // edge marked a dead end for this resolution and effort) and the search backs up one state.
+  struct Committed {
+    SymState s;
+    ContState c;
+    std::uint64_t entering_edge = 0;
+  };
   for (int level = 0; level < levels; ++level) {
     const Resolution res = ResolutionAt(level);
     for (int effort = 0; effort <= options_.max_effort; ++effort) {
       bool suspended_below = false;  // an edge that failed at this effort could be retried
-      while (true) {
-        const SearchStatus status = BestFirst(s0, m, res, effort, excluded, path);
+      std::vector<Committed> prefix{{s0, c0, 0}};
+      std::vector<PlanAction> actions;
+      std::unordered_map<std::uint64_t, bool> dead_ends;  // edges into abandoned states
+      int root_failures = 0;
+      while (!prefix.empty()) {
+        const SearchStatus status =
+            BestFirst(prefix.back().s, m, res, effort, excluded, dead_ends,
+                      prefix.size() == 1 ? options_.max_nodes
+                                         : std::min(options_.max_nodes, kLocalNodes),
+                      path);
+        if (std::getenv("WRAP_TASK_DEBUG")) {
+          std::fprintf(stderr,
+                       "[task] milestone %d level %d effort %d depth %zu: status %d, %zu nodes, "
+                       "path %zu\n",
+                       index, level, effort, prefix.size() - 1, static_cast<int>(status),
+                       nodes_.size(), path.size());
+        }
         if (status == SearchStatus::kStopped) {
           result.stopped = true;
           result.failure = "stopped";
           return result;
         }
-        if (status != SearchStatus::kFound) break;
-        // Validate the candidate plan edge by edge from the start.
-        SymState s = s0;
-        ContState c = c0;
-        std::vector<PlanAction> actions;
+        if (status != SearchStatus::kFound) {
+          // Nothing from here: abandon this state.
+          if (prefix.size() == 1) break;
+          dead_ends[prefix.back().entering_edge] = true;
+          prefix.pop_back();
+          actions.pop_back();
+          continue;
+        }
+        // Validate the candidate plan edge by edge, committing what holds.
         bool valid = true;
         for (int node_index : path) {
           if (ctx_.ShouldStop()) {
@@ -522,6 +615,8 @@ MilestoneResult TaskSearch::Fill(int index, int step, bool final, const SymState
             result.failure = "stopped";
             return result;
           }
+          const SymState& s = prefix.back().s;
+          const ContState& c = prefix.back().c;
           const TaskAction a = nodes_[node_index].a;
           const SymState next = nodes_[node_index].s;
           const std::uint64_t edge = EdgeKey(s, a);
@@ -533,6 +628,12 @@ MilestoneResult TaskSearch::Fill(int index, int step, bool final, const SymState
             EdgeOutcome outcome =
                 solver_.Validate(s, c, a, next, edge_level, HashMix(seed_, edge));
             if (!outcome.ok) {
+              if (std::getenv("WRAP_TASK_DEBUG")) {
+                std::fprintf(stderr, "[task]   edge %s r%d r%d obj %d: %s: %s%s\n",
+                             std::string(ToString(a.type)).c_str(), a.r1, a.r2, a.obj,
+                             std::string(GateName(outcome.gate)).c_str(), outcome.message.c_str(),
+                             outcome.permanent ? " (permanent)" : "");
+              }
               tally_.Add(outcome.gate, outcome.message);
               failed_level_[edge] = outcome.permanent ? kPermanent : edge_level;
               if (!outcome.permanent && edge_level < options_.max_effort) suspended_below = true;
@@ -542,14 +643,18 @@ MilestoneResult TaskSearch::Fill(int index, int step, bool final, const SymState
             w = witnesses_.emplace(witness_key, std::move(outcome)).first;
           }
           actions.push_back(MakeAction(s, a, w->second, index));
-          s = next;
-          c = w->second.next;
+          prefix.push_back({next, w->second.next, edge});
+        }
+        if (!valid && ++root_failures <= kRootFailures) {
+          // Early on, search again from the milestone's start: shorter plans.
+          prefix.resize(1);
+          actions.clear();
         }
         if (valid) {
           result.ok = true;
           result.actions = std::move(actions);
-          result.end = s;
-          result.end_c = c;
+          result.end = prefix.back().s;
+          result.end_c = prefix.back().c;
           search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
           return result;
         }
@@ -559,7 +664,6 @@ MilestoneResult TaskSearch::Fill(int index, int step, bool final, const SymState
     if (level + 1 < levels) ++widenings_;
   }
   search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
-  (void)milestone_expansions;
   const StepInterface& st = world_.interface(step);
   result.failure = "milestone " + std::to_string(index + 1) + " '" + world_.tree->nodes[step].name +
                    "' (moving '" + world_.tree->nodes[st.moved].name + "' onto '" +

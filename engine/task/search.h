@@ -25,6 +25,8 @@ struct GateTally {
   std::array<long long, kNumGates> count{};
   std::array<std::string, kNumGates> example;
   void Add(Gate gate, const std::string& message);
+  Gate last_gate = Gate::kNone;  ///< Gate of the last Add.
+  std::string last_message;      ///< Message of the last Add.
   /// e.g. "wrench (assembly) 120x (e.g. ...), IK 40x (...)".
   std::string Summary(int max_gates = 3) const;
 };
@@ -45,9 +47,10 @@ class TaskSearch {
   TaskSearch(const TaskWorld& world, TaskTables& tables, KeyframeSolver& solver,
              const TaskPlannerOptions& options, RunContext& ctx, std::uint64_t seed, bool widen);
 
-  /// Plans milestone `index` (step node `step`); `final` also asks every robot to be free at the
-  /// end. End states whose hash is in `excluded` do not count as goals (backtracking).
-  MilestoneResult Fill(int index, int step, bool final, const SymState& s0, const ContState& c0,
+  /// Plans milestone `index` (step node `step`). At its end robots may hold only the inputs of
+  /// `next_step` (the next milestone's step; -1 for the last milestone: every robot free). End
+  /// states whose hash is in `excluded` do not count as goals (backtracking).
+  MilestoneResult Fill(int index, int step, int next_step, const SymState& s0, const ContState& c0,
                        const std::set<std::uint64_t>& excluded);
 
   long long expansions() const { return expansions_; }
@@ -66,6 +69,7 @@ class TaskSearch {
     int moved = -1;
     int base = -1;
     bool final = false;
+    int keep[2] = {-2, -2};  ///< Nodes robots may still hold at the end.
   };
   struct Node {
     SymState s;
@@ -83,7 +87,9 @@ class TaskSearch {
                   std::vector<std::pair<TaskAction, SymState>>& out);
   SymState Apply(const SymState& s, const TaskAction& a) const;
   SearchStatus BestFirst(const SymState& s0, const Milestone& m, const Resolution& res, int effort,
-                         const std::set<std::uint64_t>& excluded, std::vector<int>& path);
+                         const std::set<std::uint64_t>& excluded,
+                         const std::unordered_map<std::uint64_t, bool>& dead_ends,
+                         long long node_budget, std::vector<int>& path);
   bool CheapPick(int robot, int node, int loc, int grasp);
   bool CheapPlace(int robot, int node, int loc, int grasp);
   bool CheapAssemble(const SymState& s, const Milestone& m);
@@ -103,7 +109,14 @@ class TaskSearch {
   std::map<std::pair<int, int>, std::vector<int>> grasp_ids_;
   std::unordered_map<std::uint64_t, int> failed_level_;   // edge key -> level failed at
   std::unordered_map<std::uint64_t, EdgeOutcome> witnesses_;  // continuous edge key -> outcome
-  std::unordered_map<std::uint64_t, bool> cheap_;         // cheap-check answers
+  struct CheapAnswer {
+    bool ok = true;
+    Gate gate = Gate::kNone;
+    std::string why;
+  };
+  bool Recall(const CheapAnswer& answer);      // tallies a cached failure again
+  void Remember(std::uint64_t key, bool ok);  // caches with the last tallied reason
+  std::unordered_map<std::uint64_t, CheapAnswer> cheap_;  // cheap-check answers
   std::vector<Iso3> placement_pose_;                       // scratch
   long long expansions_ = 0;
   int widenings_ = 0;

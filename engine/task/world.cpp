@@ -97,6 +97,47 @@ std::vector<Vec3> Hull2d(std::vector<Vec3> points) {
   return hull;
 }
 
+// Sutherland-Hodgman clipping of a convex counter-clockwise polygon (or fewer points) to an
+// axis-aligned rectangle in x, y; the result lies at height z.
+std::vector<Vec3> ClipToRectangle(std::vector<Vec3> poly, double x0, double x1, double y0,
+                                  double y1, double z) {
+  auto clip = [](const std::vector<Vec3>& in, auto inside, auto cut) {
+    std::vector<Vec3> out;
+    const size_t n = in.size();
+    if (n == 0) return out;
+    if (n == 1) {
+      if (inside(in[0])) out.push_back(in[0]);
+      return out;
+    }
+    for (size_t i = 0; i < n; ++i) {
+      const Vec3& a = in[i];
+      const Vec3& b = in[(i + 1) % n];
+      const bool ia = inside(a), ib = inside(b);
+      if (ia) out.push_back(a);
+      if (ia != ib && (n > 2 || i == 0)) out.push_back(cut(a, b));
+    }
+    return out;
+  };
+  auto along_x = [](double x) {
+    return [x](const Vec3& a, const Vec3& b) {
+      const double t = (x - a.x()) / (b.x() - a.x());
+      return Vec3(x, a.y() + t * (b.y() - a.y()), a.z());
+    };
+  };
+  auto along_y = [](double y) {
+    return [y](const Vec3& a, const Vec3& b) {
+      const double t = (y - a.y()) / (b.y() - a.y());
+      return Vec3(a.x() + t * (b.x() - a.x()), y, a.z());
+    };
+  };
+  poly = clip(poly, [x0](const Vec3& p) { return p.x() >= x0; }, along_x(x0));
+  poly = clip(poly, [x1](const Vec3& p) { return p.x() <= x1; }, along_x(x1));
+  poly = clip(poly, [y0](const Vec3& p) { return p.y() >= y0; }, along_y(y0));
+  poly = clip(poly, [y1](const Vec3& p) { return p.y() <= y1; }, along_y(y1));
+  for (Vec3& p : poly) p.z() = z;
+  return poly;
+}
+
 }  // namespace
 
 const GraspSet* TaskWorld::grasp_set(int node, int robot) const {
@@ -250,10 +291,14 @@ Result<TaskWorld> BuildTaskWorld(const Project& project, const ProjectCheck& che
     cr.X_WB = robot.X_WB;
     cr.end_effector.name = robot.end_effector.name;
     cr.end_effector.X_FT = robot.end_effector.X_FT;
-    // Fingers fully open (the catalog's collision shapes): a free gripper waits open, and a
-    // holding one is checked no narrower than that (conservative; the validator uses the grasp
-    // width).
-    cr.end_effector.collision = robot.end_effector.collision;
+    // The gripper body without its fingers: the planner adds the two finger boxes as bodies of
+    // their own, opened to each keyframe's grasp width (KeyframeSolver).
+    cr.end_effector.collision.clear();
+    for (size_t i = 0; i < robot.end_effector.collision.size(); ++i) {
+      const auto& f = robot.end_effector.finger_shapes;
+      if (static_cast<int>(i) == f[0] || static_cast<int>(i) == f[1]) continue;
+      cr.end_effector.collision.push_back(robot.end_effector.collision[i]);
+    }
     cr.reference_link_frames.resize(robot.chain.links.size());
     ForwardKinematics(robot.chain, robot.X_WB, robot.home, cr.reference_link_frames);
     w.cell_def.robots.push_back(std::move(cr));
@@ -277,6 +322,7 @@ std::vector<std::pair<int, std::vector<Vec3>>> TableContacts(const TaskWorld& wo
   for (const Vec3& v_A : sub.hull.mesh.vertices) {
     const Vec3 v_W = X_WA * v_A;
     if (v_W.z() > world.table_top + tolerance_m) continue;
+
     // The part whose box is nearest to the vertex.
     int best = n.parts.front();
     double best_d = std::numeric_limits<double>::infinity();
@@ -295,10 +341,20 @@ std::vector<std::pair<int, std::vector<Vec3>>> TableContacts(const TaskWorld& wo
     }
     it->second.push_back(Vec3(v_W.x(), v_W.y(), world.table_top));
   }
+  const Vec3 half = 0.5 * world.project->table.size;
   for (auto& [part, points] : out) {
-    if (points.size() > 3) points = Hull2d(std::move(points));
-    while (points.size() > 16) points.erase(points.begin() + 1);  // rare: very round bases
+    if (points.size() >= 3) points = Hull2d(std::move(points));
+    // Only what lies over the table top is supported: clip to the table's rectangle.
+    points = ClipToRectangle(std::move(points), world.table_center.x() - half.x(),
+                             world.table_center.x() + half.x(), world.table_center.y() - half.y(),
+                             world.table_center.y() + half.y(), world.table_top);
+    if (points.size() > 16) {  // a round base: keep 16 corners spread along the hull
+      std::vector<Vec3> kept;
+      for (int i = 0; i < 16; ++i) kept.push_back(points[i * points.size() / 16]);
+      points = std::move(kept);
+    }
   }
+  std::erase_if(out, [](const auto& e) { return e.second.empty(); });
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   return out;
 }

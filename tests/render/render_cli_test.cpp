@@ -319,8 +319,8 @@ TEST(RenderCli, PlanKeyframesAreDrawn) {
 
   // Keyframe indices as times: --frames N evenly, --at picks keyframes.
   const fs::path frames = OutDir("plan_frames");
-  r = RunWrap({"render", Project("stool"), "--plan", plan.string(), "-o", frames.string(),
-               "--size", "160x120", "--frames", "3"});
+  r = RunWrap({"render", Project("stool"), "--plan", plan.string(), "-o", frames.string(), "--size",
+               "160x120", "--frames", "3"});
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* f : {"frame_000.png", "frame_001.png", "frame_002.png"}) {
     EXPECT_TRUE(fs::exists(frames / f)) << f;

@@ -125,9 +125,9 @@ Plan StoolPlan() {
   plan.actions.push_back(Action(ActionType::kRelease, {kB}, {kSeatLeg1},
                                 {{kB, Grasp(kSeat, 5, kSeat, 0.0)}},
                                 MakeKeyframe(0.05, true, true)));
-  PlanAction place = Action(ActionType::kPlace, {kA}, {kSeatLeg1},
-                            {{kA, Grasp(kSeatLeg1, 7, kLeg1, 0.029)}},
-                            MakeKeyframe(0.06, true, true));
+  PlanAction place =
+      Action(ActionType::kPlace, {kA}, {kSeatLeg1}, {{kA, Grasp(kSeatLeg1, 7, kLeg1, 0.029)}},
+             MakeKeyframe(0.06, true, true));
   place.placement = PlanPlacement{1, 4, 2};
   place.milestone = 1;
   place.start_s = 12.5;
@@ -278,8 +278,7 @@ TEST(PlanJson, DocumentLayout) {
   std::vector<std::string> keys;
   for (const auto& [key, value] : doc.items()) keys.push_back(key);
   EXPECT_EQ(keys, (std::vector<std::string>{"format", "version", "project", "robots", "parts",
-                                             "nodes", "milestones", "stats", "initial",
-                                             "actions"}));
+                                            "nodes", "milestones", "stats", "initial", "actions"}));
   EXPECT_EQ(doc["format"], "wrap-plan");
   EXPECT_EQ(doc["version"], 1);
   EXPECT_EQ(doc["milestones"], json::array({"seat+leg1", "seat+legs1-2"}));
@@ -337,7 +336,9 @@ std::string Text(const std::function<void(json&)>& change) {
 
 TEST(PlanJson, MalformedDocumentsAreRefusedNamingTheField) {
   const std::vector<Malformed> cases = {
-      {"format", [](json& d) { d["format"] = "wrap-project"; }, {"plan.json: format:", "wrap-plan"}},
+      {"format",
+       [](json& d) { d["format"] = "wrap-project"; },
+       {"plan.json: format:", "wrap-plan"}},
       {"version", [](json& d) { d["version"] = 2; }, {"version:", "expected 1"}},
       {"missing_actions", [](json& d) { d.erase("actions"); }, {"actions: required field"}},
       {"missing_stats_field",
@@ -359,7 +360,9 @@ TEST(PlanJson, MalformedDocumentsAreRefusedNamingTheField) {
        [](json& d) { d["actions"][0]["keyframe"]["q"].erase("ur5e_d"); },
        {"actions[0].keyframe.q.ur5e_d", "missing"}},
       {"joint_unknown_robot",
-       [](json& d) { d["initial"]["q"]["ur10e"] = json::array({0, 0, 0, 0, 0, 0}); },
+       [](json& d) {
+         d["initial"]["q"]["ur10e"] = json::array({0, 0, 0, 0, 0, 0});
+       },
        {"initial.q.ur10e: unknown robot"}},
       {"too_many_joints",
        [](json& d) { d["initial"]["q"]["ur5e_a"] = std::vector<double>(11, 0.0); },
@@ -416,7 +419,9 @@ TEST(PlanJson, MalformedDocumentsAreRefusedNamingTheField) {
        [](json& d) { d["actions"][2]["index"] = 5; },
        {"actions[2].index: expected 2"}},
       {"placement_on_pick",
-       [](json& d) { d["actions"][0]["placement"] = json{{"placement", 0}, {"slot", 0}, {"yaw", 0}}; },
+       [](json& d) {
+         d["actions"][0]["placement"] = json{{"placement", 0}, {"slot", 0}, {"yaw", 0}};
+       },
        {"actions[0].placement: only a place action"}},
       {"approach_on_pick",
        [](json& d) { d["actions"][0]["approach"] = d["actions"][0]["keyframe"]; },
@@ -427,11 +432,21 @@ TEST(PlanJson, MalformedDocumentsAreRefusedNamingTheField) {
       {"unknown_field",
        [](json& d) { d["actions"][1]["colour"] = "red"; },
        {"actions[1].colour: unknown field"}},
-      {"seed_negative", [](json& d) { d["stats"]["seed"] = -1; }, {"stats.seed: expected an integer >= 0"}},
+      {"seed_negative",
+       [](json& d) { d["stats"]["seed"] = -1; },
+       {"stats.seed: expected an integer >= 0"}},
       {"stats_type", [](json& d) { d["stats"] = json::array(); }, {"stats: expected an object"}},
-      {"actions_type", [](json& d) { d["actions"] = "none"; }, {"actions: expected an array, found a string"}},
-      {"action_type_null", [](json& d) { d["actions"][1] = nullptr; }, {"actions[1]: expected an object, found null"}},
-      {"top_level_array", [](json& d) { d = json::array({1, 2}); }, {"plan.json: expected a JSON object"}},
+      {"actions_type",
+       [](json& d) { d["actions"] = "none"; },
+       {"actions: expected an array, found a string"}},
+      {"action_type_null",
+       [](json& d) { d["actions"][1] = nullptr; },
+       {"actions[1]: expected an object, found null"}},
+      {"top_level_array",
+       [](json& d) {
+         d = json::array({1, 2});
+       },
+       {"plan.json: expected a JSON object"}},
   };
   ASSERT_GE(cases.size(), 12u);
   for (const Malformed& c : cases) {
@@ -457,6 +472,12 @@ TEST(PlanJson, BrokenTextIsRefusedWithoutCrashing) {
       {"{\"format\": \"wrap-plan\", \"format\": \"wrap-plan\"}", "duplicate key \"format\""},
       {std::string(100000, '['), "malformed JSON"},
       {"\"wrap-plan\"", "expected a JSON object at the top level, found a string"},
+      {"{\"format\": \"wrap-plan\", \"version\": " + std::string(50000, '[') +
+           std::string(50000, ']') + "}",
+       "version: expected 1 (the version this build reads), found an array"},
+      {"{\"format\": \"wrap-plan\", \"version\": 1, \"deep\": " + std::string(50000, '[') +
+           std::string(50000, ']') + "}",
+       "deep: unknown field"},
   };
   for (const Case& c : cases) {
     auto parsed = ParsePlan(c.text, "p.json");
@@ -548,7 +569,8 @@ TEST_F(MatchesProject, RefusesWrongJointCountsAndIndices) {
   ExpectRefused(approach, *stool_, {"actions[3].approach.q.ur5e_c: expected 6 numbers"});
   Plan grasp = StoolPlan();
   grasp.actions[0].grasps[0].grasp.part = kSeat;
-  ExpectRefused(grasp, *stool_, {"actions[0].grasps[0].part", "'seat' is not in subassembly 'leg1'"});
+  ExpectRefused(grasp, *stool_,
+                {"actions[0].grasps[0].part", "'seat' is not in subassembly 'leg1'"});
   Plan range = StoolPlan();
   range.actions[2].objects[0] = 40;
   ExpectRefused(range, *stool_, {"actions[2].objects[0]", "out of range"});

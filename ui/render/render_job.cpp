@@ -1,5 +1,6 @@
 #include "render/render_job.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -226,6 +227,172 @@ Result<std::vector<double>> FrameTimes(double duration_s, int frames,
     times.push_back(frames == 1 ? 0.0 : duration_s * double(i) / double(frames - 1));
   }
   return times;
+}
+
+namespace {
+
+// The keyframe of a timeline entry.
+const Keyframe& KeyframeOf(const Plan& plan, const PlanTimelineEntry& e) {
+  if (e.action < 0) return plan.initial;
+  const PlanAction& a = plan.actions[e.action];
+  return e.approach && a.approach ? *a.approach : a.keyframe;
+}
+
+std::string EntryName(const PlanTimelineEntry& e) {
+  if (e.action < 0) return "initial";
+  return "actions[" + std::to_string(e.action) + "]." + (e.approach ? "approach" : "keyframe");
+}
+
+// A keyframe as a scene state, with the robots' finger openings given.
+Result<SceneState> KeyframeState(const CellScene& scene, const AssemblyTree& tree,
+                                 const Keyframe& k, const std::string& where,
+                                 std::vector<double> opening_m) {
+  auto bad = [&](const std::string& m) {
+    return Fail(ErrorCode::kInvalidInput, "plan: " + where + ": " + m);
+  };
+  if (k.q.size() != scene.robots.size()) {
+    return bad("joint values of " + std::to_string(k.q.size()) + " robots, the cell has " +
+               std::to_string(scene.robots.size()));
+  }
+  SceneState state;
+  for (size_t r = 0; r < k.q.size(); ++r) {
+    const SceneRobot& robot = scene.robots[r];
+    if (k.q[r].size() != robot.chain.dof()) {
+      return bad("robot '" + robot.name + "' has " + std::to_string(robot.chain.dof()) +
+                 " joints, the keyframe gives " + std::to_string(k.q[r].size()) + " values");
+    }
+    state.q.push_back(k.q[r]);
+  }
+  state.opening_m = std::move(opening_m);
+  state.X_WP.assign(scene.parts.size(), Iso3::Identity());
+  std::vector<bool> placed(scene.parts.size(), false);
+  for (const PlanObject& o : k.objects) {
+    if (o.node < 0 || o.node >= static_cast<int>(tree.nodes.size())) {
+      return bad("object node " + std::to_string(o.node) + " is not in the assembly");
+    }
+    for (int p : tree.nodes[o.node].parts) {
+      if (p < 0 || p >= static_cast<int>(scene.parts.size()) || placed[p]) {
+        return bad("part " + (p >= 0 && p < int(scene.parts.size())
+                                  ? "'" + scene.parts[p].name + "' is in two objects"
+                                  : std::to_string(p) + " is not in the cell"));
+      }
+      placed[p] = true;
+      state.X_WP[p] = o.X_WA * scene.parts[p].X_AP;
+    }
+  }
+  for (size_t p = 0; p < placed.size(); ++p) {
+    if (!placed[p]) return bad("part '" + scene.parts[p].name + "' is in no object");
+  }
+  return state;
+}
+
+}  // namespace
+
+std::vector<PlanTimelineEntry> PlanTimeline(const Plan& plan) {
+  std::vector<PlanTimelineEntry> timeline = {{-1, false}};
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    if (plan.actions[i].approach) timeline.push_back({static_cast<int>(i), true});
+    timeline.push_back({static_cast<int>(i), false});
+  }
+  return timeline;
+}
+
+Result<std::vector<SceneState>> PlanStates(const CellScene& scene, const AssemblyTree& tree,
+                                           const Plan& plan) {
+  // Who holds what, replayed action by action: the grasp each robot holds, if any.
+  std::vector<std::optional<PlanGrasp>> holds(scene.robots.size());
+  auto openings = [&] {
+    std::vector<double> opening(scene.robots.size());
+    for (size_t r = 0; r < scene.robots.size(); ++r) {
+      const double stroke = scene.robots[r].end_effector.stroke_m;
+      opening[r] = holds[r] ? std::clamp(holds[r]->width_m, 0.0, stroke) : stroke;
+    }
+    return opening;
+  };
+  std::vector<SceneState> states;
+  for (const PlanTimelineEntry& e : PlanTimeline(plan)) {
+    if (e.action >= 0) {
+      // From the approach (the holders already hold) and at the keyframe (new grasps closed),
+      // every acting robot has the grasp the action lists for it (plan.h).
+      const PlanAction& a = plan.actions[e.action];
+      for (size_t k = 0; k < a.robots.size() && k < a.grasps.size(); ++k) {
+        const int r = a.robots[k];
+        if (r >= 0 && r < static_cast<int>(holds.size())) holds[r] = a.grasps[k].grasp;
+      }
+    }
+    auto state = KeyframeState(scene, tree, KeyframeOf(plan, e), EntryName(e), openings());
+    if (!state) return std::unexpected(state.error());
+    states.push_back(std::move(*state));
+    if (e.action >= 0 && !e.approach) {
+      // After the keyframe: who lets go.
+      const PlanAction& a = plan.actions[e.action];
+      const bool lets_go = a.type == ActionType::kPlace || a.type == ActionType::kRelease ||
+                           a.type == ActionType::kHandover;
+      if (lets_go && !a.robots.empty() && a.robots[0] >= 0 &&
+          a.robots[0] < static_cast<int>(holds.size())) {
+        holds[a.robots[0]].reset();
+      }
+    }
+  }
+  return states;
+}
+
+Result<std::vector<Shot>> PlanShots(const CellScene& scene, const AssemblyTree& tree,
+                                    const Plan& plan, const PlanShotOptions& options) {
+  auto states = PlanStates(scene, tree, plan);
+  if (!states) return std::unexpected(states.error());
+  const std::vector<PlanTimelineEntry> timeline = PlanTimeline(plan);
+  const int last = static_cast<int>(timeline.size()) - 1;
+
+  auto caption = [&](int k) {
+    const PlanTimelineEntry& e = timeline[k];
+    std::string words = std::to_string(k) + ": ";
+    if (e.action < 0) return words + "initial scene";
+    const PlanAction& a = plan.actions[e.action];
+    return words + (e.approach ? "approach: " : "") + DescribeAction(plan, a);
+  };
+  auto file_name = [&](int k) {
+    const PlanTimelineEntry& e = timeline[k];
+    std::string type = "initial";
+    if (e.action >= 0) {
+      type = std::string(ToString(plan.actions[e.action].type)) + (e.approach ? "_approach" : "");
+    }
+    char name[64];
+    std::snprintf(name, sizeof name, "plan_%03d_%s.png", k, type.c_str());
+    return std::string(name);
+  };
+
+  std::vector<Shot> shots;
+  if (options.at.empty() && options.frames < 0) {
+    for (int k = 0; k <= last; ++k) shots.push_back({(*states)[k], caption(k), file_name(k)});
+    return shots;
+  }
+  // Keyframe indices as times: --at names keyframes, --frames spreads over them.
+  std::vector<double> times;
+  if (!options.at.empty()) {
+    for (double t : options.at) {
+      if (!(t >= 0.0 && t <= last && t == std::floor(t))) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "--at: %g is not a keyframe index of the plan (with --plan, --at takes "
+                      "whole numbers from 0, the initial keyframe, to %d)",
+                      t, last);
+        return Fail(ErrorCode::kInvalidInput, buf);
+      }
+    }
+    times = options.at;
+  } else {
+    auto even = FrameTimes(double(last), options.frames, {});
+    if (!even) return std::unexpected(even.error());
+    times = std::move(*even);
+  }
+  for (size_t f = 0; f < times.size(); ++f) {
+    const int k = std::clamp(static_cast<int>(std::lround(times[f])), 0, last);
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%03zu.png", f);
+    shots.push_back({(*states)[k], caption(k), name});
+  }
+  return shots;
 }
 
 }  // namespace wrap::render

@@ -3,8 +3,9 @@
 // rendering; `wrap render` fills a RenderJob and calls RunRenderJob.
 //
 // Where the shots come from: without a plan, StillShots gives the initial scene and the
-// assembled (and exploded) goal. With a plan (issue "plan"), a plan timeline gives the scene
-// state and the action in words at each time of FrameTimes, one shot per time.
+// assembled (and exploded) goal. With a plan, PlanShots draws its keyframes: the plan's timeline
+// is its keyframes in order (the initial one, then each action's approach, if any, and its
+// keyframe), with the keyframe index as time until plans are retimed; FrameTimes picks along it.
 #pragma once
 
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include "render/gl_context.h"
 #include "sim/mjcf.h"
 #include "sim/scene.h"
+#include "task/plan.h"
 
 namespace wrap::render {
 
@@ -97,5 +99,44 @@ Result<std::vector<Shot>> StillShots(const CellScene& scene, const StillShotOpti
 /// t = 0). Fails with kInvalidInput for frames < 1, a time outside the timeline or not finite.
 Result<std::vector<double>> FrameTimes(double duration_s, int frames,
                                        const std::vector<double>& at_s);
+
+/// One keyframe of a plan's timeline.
+struct PlanTimelineEntry {
+  int action = -1;        ///< Index into Plan::actions; -1 for the initial keyframe.
+  bool approach = false;  ///< The action's approach keyframe (assemble), not its keyframe.
+};
+
+/// The plan's keyframes in order: the initial one, then per action its approach (if any) and
+/// its keyframe. Entry k is time k of the timeline.
+std::vector<PlanTimelineEntry> PlanTimeline(const Plan& plan);
+
+/// The scene state at every entry of PlanTimeline. A keyframe becomes a state by its robots'
+/// joints and its objects' poses (each part P of object A at X_WA * X_AP); a robot that holds
+/// something (replaying the actions: pick, add_grasp and a handover's receiver take hold; place,
+/// release and a handover's giver let go, after their keyframe) closes its fingers to the
+/// grasp's width, the others are fully open. `tree` is the project's DAG (ProjectCheck::tree).
+/// Fails with kInvalidInput naming the keyframe when a joint vector does not fit its robot's
+/// chain, an object is not a node of `tree`, or a part is in no object or in two; check the plan
+/// with CheckPlanMatchesProject first for messages that name the file and the field.
+Result<std::vector<SceneState>> PlanStates(const CellScene& scene, const AssemblyTree& tree,
+                                           const Plan& plan);
+
+/// Options of PlanShots.
+struct PlanShotOptions {
+  /// >= 1: this many frames evenly along the timeline, frame k of N showing keyframe
+  /// round(k (K - 1) / (N - 1)) of K; negative: every keyframe once; 0 is refused.
+  int frames = -1;
+  /// Keyframe indices to draw, in this order (whole numbers in [0, K - 1]); when given they
+  /// replace `frames`.
+  std::vector<double> at;
+};
+
+/// The shots of a plan: by default one per keyframe, named "plan_KKK_TYPE.png" (KKK the
+/// keyframe's index on the timeline, zero-padded; TYPE "initial", the action type, or the type
+/// and "_approach"), captioned with the action in words; with `frames` or `at`, "frame_NNN.png"
+/// per frame. Fails with kInvalidInput as PlanStates, or for frames or keyframe indices that do
+/// not fit the timeline (messages name --frames and --at).
+Result<std::vector<Shot>> PlanShots(const CellScene& scene, const AssemblyTree& tree,
+                                    const Plan& plan, const PlanShotOptions& options);
 
 }  // namespace wrap::render

@@ -122,48 +122,58 @@ std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
     const int approaches = std::clamp(options.approach_samples, 1, kMaxApproaches);
     // A pad rectangle is symmetric under a half turn: approaches pi apart share pad tests.
     const int period = approaches % 2 == 0 ? approaches / 2 : approaches;
-    std::array<double, kMaxApproaches> pad_p, pad_q;
-    pad_p.fill(std::numeric_limits<double>::quiet_NaN());
-    pad_q.fill(std::numeric_limits<double>::quiet_NaN());
-    for (int k = 0; k < approaches; ++k) {
+    // Two depths per approach: the pads centred on the contacts, and a shallow grasp with the
+    // contacts near the fingertips (the tips 3 mm past them), which picks thin parts lying on a
+    // table whose top the centred pads would reach into.
+    const double shallow = std::max(0.0, 0.5 * ee.pad_length_m - 0.003);
+    const int depths = shallow > 1e-4 ? 2 : 1;
+    std::array<std::array<double, kMaxApproaches>, 2> pad_p, pad_q;
+    for (auto* pads : {&pad_p, &pad_q}) {
+      for (auto& row : *pads) row.fill(std::numeric_limits<double>::quiet_NaN());
+    }
+    bool found = false;
+    for (int k = 0; k < approaches && !found; ++k) {
       const Vec3 a =
           Tilted(d, 0.5 * std::numbers::pi, phase0 + 2.0 * std::numbers::pi * k / approaches);
       const Vec3 e_w = d.cross(a);
       // Pads: the one at -d pushes p along +d, the one at +d pushes q along -d.
       const int key = k % period;
-      if (std::isnan(pad_p[key])) {
-        pad_p[key] = PadContact(part, p, d, e_w, a, ee.pad_width_m, ee.pad_length_m,
-                                options.contact_tolerance_m, back, rays_w, rays_l, min_hits);
+      for (int depth = 0; depth < depths; ++depth) {
+        const double shift = depth == 0 ? 0.0 : shallow;
+        double& area_p = pad_p[depth][key];
+        if (std::isnan(area_p)) {
+          area_p = PadContact(part, p - shift * a, d, e_w, a, ee.pad_width_m, ee.pad_length_m,
+                              options.contact_tolerance_m, back, rays_w, rays_l, min_hits);
+        }
+        if (area_p < options.min_pad_contact_m2) continue;
+        double& area_q = pad_q[depth][key];
+        if (std::isnan(area_q)) {
+          area_q = PadContact(part, q - shift * a, -d, e_w, a, ee.pad_width_m, ee.pad_length_m,
+                              options.contact_tolerance_m, back, rays_w, rays_l, min_hits);
+        }
+        if (area_q < options.min_pad_contact_m2) continue;
+        Iso3 X_PG = Iso3::Identity();
+        X_PG.linear() = FrameFromAxes(d, a, c_T, a_T);
+        X_PG.translation() = m - X_PG.linear() * pad_T - shift * a;
+        if (world.Collides(in.ee_index, in.X_AP * X_PG, width + 2.0 * options.clearance_m)) {
+          continue;
+        }
+        GraspCandidate c;
+        c.grasp.part = in.part_index;
+        c.grasp.end_effector = ee.name;
+        c.grasp.kind = ee.kind;
+        c.grasp.X_PG = X_PG;
+        c.grasp.width_m = width;
+        c.grasp.contacts_P = {q, p};  // the finger on G's +x (+d) side touches q
+        c.grasp.contact_area_m2 = std::min(area_p, area_q);
+        c.center_P = m;
+        c.axis_P = d;
+        c.approach_P = a;
+        c.slack = alpha > 0.0 ? 1.0 - std::max(angle_p, angle_q) / alpha : 0.0;
+        c.pad_fraction = pad_area > 0.0 ? std::min(1.0, c.grasp.contact_area_m2 / pad_area) : 0.0;
+        out.push_back(std::move(c));
+        found = true;  // one approach per contact pair keeps the candidates spread
       }
-      const double area_p = pad_p[key];
-      if (area_p < options.min_pad_contact_m2) continue;
-      if (std::isnan(pad_q[key])) {
-        pad_q[key] = PadContact(part, q, -d, e_w, a, ee.pad_width_m, ee.pad_length_m,
-                                options.contact_tolerance_m, back, rays_w, rays_l, min_hits);
-      }
-      const double area_q = pad_q[key];
-      if (area_q < options.min_pad_contact_m2) continue;
-      Iso3 X_PG = Iso3::Identity();
-      X_PG.linear() = FrameFromAxes(d, a, c_T, a_T);
-      X_PG.translation() = m - X_PG.linear() * pad_T;
-      if (world.Collides(in.ee_index, in.X_AP * X_PG, width + 2.0 * options.clearance_m)) {
-        continue;
-      }
-      GraspCandidate c;
-      c.grasp.part = in.part_index;
-      c.grasp.end_effector = ee.name;
-      c.grasp.kind = ee.kind;
-      c.grasp.X_PG = X_PG;
-      c.grasp.width_m = width;
-      c.grasp.contacts_P = {q, p};  // the finger on G's +x (+d) side touches q
-      c.grasp.contact_area_m2 = std::min(area_p, area_q);
-      c.center_P = m;
-      c.axis_P = d;
-      c.approach_P = a;
-      c.slack = alpha > 0.0 ? 1.0 - std::max(angle_p, angle_q) / alpha : 0.0;
-      c.pad_fraction = pad_area > 0.0 ? std::min(1.0, c.grasp.contact_area_m2 / pad_area) : 0.0;
-      out.push_back(std::move(c));
-      break;  // one grasp per contact pair keeps the candidates spread
     }
   }
   return out;
