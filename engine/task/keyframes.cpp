@@ -109,6 +109,30 @@ KeyframeSolver::KeyframeSolver(const TaskWorld& world, TaskTables& tables,
   }
 }
 
+bool KeyframeSolver::GripperClear(int robot, int grasp, const Iso3& X_WA, int other_node,
+                                  const Iso3& X_other) {
+  const TaskRobot& r = world_.robots[robot];
+  const Iso3 X_WF = GraspTarget(X_WA, grasp) * r.end_effector.X_FT.inverse();
+  CollisionWorld& w = cell_.world();
+  const BodyId ee = cell_.end_effector_body(robot);
+  w.SetPose(ee, X_WF);
+  if (fingers_[robot]) {
+    opening_[robot] = GraspOpening(grasp);
+    PlaceFingers(robot, X_WF);
+  }
+  bool hit = false;
+  for (int p : world_.tree->nodes[other_node].parts) {
+    const BodyId part = cell_.object_body(p);
+    cell_.SetObjectPose(p, X_other * world_.X_AP[p]);
+    hit = hit || w.Collide(ee, part);
+    if (fingers_[robot]) {
+      for (int k = 0; k < 2 && !hit; ++k) hit = w.Collide(fingers_[robot]->body[k], part);
+    }
+  }
+  // Every validation sets the robots and the scene again before it checks anything.
+  return !hit;
+}
+
 double KeyframeSolver::GraspOpening(int grasp) const {
   return tables_.grasp(grasp).width_m + 0.002;
 }
@@ -309,12 +333,19 @@ void KeyframeSolver::SetScene(const std::vector<PlanObject>& objects,
     }
   }
   const BodyId table = cell_.table_body();
+  std::vector<char> touching(objects.size(), 0);
+  for (size_t i = 0; i < objects.size(); ++i) {
+    touching[i] = !objects[i].resting &&
+                  std::abs(LowestPoint(world_, objects[i].node, objects[i].X_WA) -
+                           world_.table_top) <= kTouchTolerance;
+  }
   for (int p = 0; p < world_.num_parts; ++p) {
     const BodyId body = cell_.object_body(p);
     const int op = part_object_[p];
     w.SetEnabled(body, op >= 0);
     if (op < 0) continue;
-    w.SetAllowed(body, table, objects[op].resting);
+    // Resting objects touch the table, and so does one just picked, still where it rested.
+    w.SetAllowed(body, table, objects[op].resting || touching[op]);
     for (int q = p + 1; q < world_.num_parts; ++q) {
       const int oq = part_object_[q];
       if (oq < 0) continue;
@@ -580,7 +611,7 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
         X[M] = X[B];
         // A moved input that reaches down to the table top slides along it into a resting base.
         keyframe_resting[M] =
-            b_rests && LowestPoint(world_, M, X[M]) <= world_.table_top + kTouchTolerance;
+            b_rests && std::abs(LowestPoint(world_, M, X[M]) - world_.table_top) <= kTouchTolerance;
         if (!b_rests && !above_table(B, X[B])) return false;
         // The moved input must not reach under the table top.
         return LowestPoint(world_, M, X[M]) >= world_.table_top - 1e-3;
@@ -642,12 +673,40 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
   bool success = false;
   std::vector<JointVector> chosen(movers.size());
   std::optional<Keyframe> approach;
-  for (int k = 0; k < n_candidates && !success; ++k) {
-    X = c.X_WA;
-    if (!make(k, X)) {
-      note(Gate::kTable, "the object would be below the table top");
-      continue;
+  bool park_home = true;  // freed robots go home (else they stay, gripper open)
+  // Candidate poses. When poses are sampled, draw a larger pool and try first those where
+  // every acting gripper approaches its grasp from its own robot's side (the approach axis
+  // pointing away from the robot's shoulder): arms then reach without crossing each other.
+  std::vector<std::vector<Iso3>> candidates;
+  {
+    const int pool = reposed.empty() ? n_candidates : 4 * n_candidates;
+    std::vector<std::pair<double, int>> scored;
+    for (int k = 0; k < pool; ++k) {
+      std::vector<Iso3> Xk = c.X_WA;
+      if (!make(k, Xk)) {
+        note(Gate::kTable, "the object would be below the table top");
+        continue;
+      }
+      double score = 1.0;
+      for (const Mover& m : movers) {
+        const Iso3 T = GraspTarget(Xk[m.node], m.grasp);
+        const Vec3 from = (T.translation() - world_.robots[m.robot].shoulder_W).normalized();
+        score = std::min(score, T.linear().col(2).dot(from));
+      }
+      // Keep the first candidate (the current pose) first: it needs no carrying.
+      scored.push_back({k == 0 ? 2.0 : score, static_cast<int>(candidates.size())});
+      candidates.push_back(std::move(Xk));
     }
+    std::stable_sort(scored.begin(), scored.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::vector<std::vector<Iso3>> ordered;
+    for (int i = 0; i < static_cast<int>(scored.size()) && i < n_candidates; ++i) {
+      ordered.push_back(std::move(candidates[scored[i].second]));
+    }
+    candidates = std::move(ordered);
+  }
+  for (size_t k = 0; k < candidates.size() && !success; ++k) {
+    X = candidates[k];
     Gate g = Gate::kNone;
     std::string message;
     if (!gates(X, g, message)) {
@@ -705,35 +764,33 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
         }
       }
       if (!freed.empty()) {
-        // The robots this action frees go home: that must be clear of everything that stays.
+        // The robots this action frees go home, or, when home is blocked, open their grippers
+        // and stay where they are: either must be clear of everything that stays.
         std::vector<std::pair<int, int>> holds_after;
         for (const auto& h : holds_at_keyframe) {
           if (std::find(freed.begin(), freed.end(), h.first) == freed.end()) holds_after.push_back(h);
         }
-        SetScene(objects, holds_after, allow_a, allow_b);
-        for (int r : freed) SetRobot(r, world_.robots[r].home);
-        for (size_t i = 0; i < movers.size(); ++i) {
-          if (std::find(freed.begin(), freed.end(), movers[i].robot) == freed.end()) {
-            SetRobot(movers[i].robot, q[i]);
+        auto at_keyframe = [&](int r) -> JointVector {
+          for (size_t i = 0; i < movers.size(); ++i) {
+            if (movers[i].robot == r) return q[i];
           }
+          return c.q[r];
+        };
+        bool hit = true;
+        for (int option = 0; option < 2 && hit; ++option) {
+          SetScene(objects, holds_after, allow_a, allow_b);
+          for (size_t i = 0; i < movers.size(); ++i) SetRobot(movers[i].robot, q[i]);
+          for (int r : freed) SetRobot(r, option == 0 ? world_.robots[r].home : at_keyframe(r));
+          hit = Collides();
+          park_home = option == 0;
         }
-        const bool hit = Collides();
         SetScene(objects, holds_at_keyframe, allow_a, allow_b);
+        for (int r : freed) SetRobot(r, at_keyframe(r));
         for (size_t i = 0; i < movers.size(); ++i) SetRobot(movers[i].robot, q[i]);
-        if (!movers.empty()) {
-          for (int r : freed) {
-            if (std::find_if(movers.begin(), movers.end(),
-                             [r](const Mover& m) { return m.robot == r; }) == movers.end()) {
-              SetRobot(r, c.q[r]);
-            }
-          }
-        } else {
-          for (int r : freed) SetRobot(r, c.q[r]);
-        }
         if (hit) {
           search_gate = Gate::kCollision;
           leaf_message = "'" + world_.robots[freed.front()].name +
-                         "' cannot go home afterwards without a collision";
+                         "' can neither go home nor stay with its gripper open afterwards";
           return false;
         }
       }
@@ -818,7 +875,9 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
   Keyframe& kf = out.keyframe;
   kf.q = nc.q;
   for (int node : keyframe_nodes) kf.objects.push_back({node, X[node], keyframe_resting[node]});
-  for (int r : freed) nc.q[r] = world_.robots[r].home;
+  if (park_home) {
+    for (int r : freed) nc.q[r] = world_.robots[r].home;
+  }
   if (a.type == ActionType::kAssemble) {
     const StepInterface& st = world_.interface(o);
     nc.X_WA[o] = X[st.base];

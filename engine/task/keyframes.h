@@ -81,6 +81,9 @@ class KeyframeSolver {
   /// Cheap: robot's end effector with its TCP at X_WT (fingers at `opening_m`, or fully open
   /// when negative) does not hit the table.
   bool ClearOfTable(int robot, const Iso3& X_WT, double opening_m = -1.0);
+  /// Cheap and context-free: the gripper of `robot` at `grasp` on an object at X_WA (fingers
+  /// closed to the grasp) does not touch the parts of `other_node` at X_other.
+  bool GripperClear(int robot, int grasp, const Iso3& X_WA, int other_node, const Iso3& X_other);
   /// Finger opening of a robot holding with `grasp` (width plus clearance).
   double GraspOpening(int grasp) const;
   /// The wrench gate for `objects` (cached by `key`, which must identify the question), with the

@@ -7,6 +7,7 @@
 #include <climits>
 #include <queue>
 #include <tuple>
+#include <unordered_set>
 
 #include "grasp/table_slots.h"
 
@@ -23,6 +24,10 @@ constexpr long long kLocalNodes = 20000;
 // Validation failures after which the fill stops searching from the milestone's start and
 // commits to the validated prefix of its candidates.
 constexpr int kRootFailures = 40;
+// Most actions in one milestone's plan: longer candidates count as dead ends.
+constexpr int kMaxMilestoneActions = 16;
+// Validation failures in one round (resolution and effort level) before moving to the next.
+constexpr int kRoundFailures = 400;
 
 std::uint64_t EdgeKey(const SymState& s, const TaskAction& a) {
   return HashMix(s.Hash(), a.Hash());
@@ -108,9 +113,14 @@ const std::vector<int>& TaskSearch::GraspIds(int node, int robot) {
 bool TaskSearch::GraspsApart(int grasp_a, int grasp_b) const {
   const GraspRef& a = tables_.grasp(grasp_a);
   const GraspRef& b = tables_.grasp(grasp_b);
-  const Vec3 pa = world_.X_AP[a.part] * a.X_PG.translation();
-  const Vec3 pb = world_.X_AP[b.part] * b.X_PG.translation();
-  return (pa - pb).norm() >= 0.04;
+  const Iso3 X_AGa = world_.X_AP[a.part] * a.X_PG;
+  const Iso3 X_AGb = world_.X_AP[b.part] * b.X_PG;
+  if ((X_AGa.translation() - X_AGb.translation()).norm() < 0.04) return false;
+  // Two grippers coming from nearly the same side of an object collide; on a small object
+  // (under 15 cm across) they need to come from opposite sides.
+  const Aabb& box = world_.pre->subassemblies[a.subassembly].aabb_A;
+  const double limit = (box.max - box.min).norm() < 0.15 ? 0.0 : 0.5;
+  return X_AGa.linear().col(2).dot(X_AGb.linear().col(2)) < limit;
 }
 
 int TaskSearch::Heuristic(const SymState& s, const Milestone& m) const {
@@ -260,7 +270,30 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
   if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(it->second);
   bool ok = true;
   std::string why;
-  if (b_rests) {
+  // Context-free: no gripper may touch the other input at the mating pose.
+  {
+    const Iso3 X = b_rests ? tables_.location(s.loc[m.base]).X_WA : Iso3::Identity();
+    for (const auto& [r, g] : mh) {
+      if (ok && !solver_.GripperClear(r, g, X, m.base, X)) {
+        ok = false;
+        tally_.Add(Gate::kCollision, "the gripper of '" + world_.robots[r].name + "' at grasp " +
+                                         std::to_string(tables_.grasp(g).index) + " of '" +
+                                         world_.tree->nodes[m.moved].name + "' hits '" +
+                                         world_.tree->nodes[m.base].name + "' when mated");
+      }
+    }
+    for (const auto& [r, g] : bh) {
+      if (ok && !solver_.GripperClear(r, g, X, m.moved, X)) {
+        ok = false;
+        tally_.Add(Gate::kCollision, "the gripper of '" + world_.robots[r].name + "' at grasp " +
+                                         std::to_string(tables_.grasp(g).index) + " of '" +
+                                         world_.tree->nodes[m.base].name + "' hits '" +
+                                         world_.tree->nodes[m.moved].name + "' when mated");
+      }
+    }
+  }
+  if (!ok) {
+  } else if (b_rests) {
     const Iso3 X_WB = tables_.location(s.loc[m.base]).X_WA;
     for (const auto& [r, g] : mh) {
       const Iso3 target = solver_.GraspTarget(X_WB, g);
@@ -272,7 +305,7 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
                                      world_.tree->nodes[m.base].name + "' where it rests");
       }
     }
-    const bool m_touches = LowestPoint(world_, m.moved, X_WB) <= world_.table_top + 2e-3;
+    const bool m_touches = std::abs(LowestPoint(world_, m.moved, X_WB) - world_.table_top) <= 2e-3;
     for (const auto& [r, g] : mh) {
       if (!ok) break;
       std::string why;
@@ -286,7 +319,7 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
                                    world_.tree->nodes[m.base].name + "' resting as it is");
     }
     if (ok) {
-      const bool m_rests = LowestPoint(world_, m.moved, X_WB) <= world_.table_top + 2e-3;
+      const bool m_rests = std::abs(LowestPoint(world_, m.moved, X_WB) - world_.table_top) <= 2e-3;
       const WrenchObject objs[2] = {{m.moved, X_WB, m_rests, mh}, {m.base, X_WB, true, bh}};
       std::uint64_t lp_key = HashMix(3, static_cast<std::uint64_t>(m.step));
       lp_key = HashMix(lp_key, static_cast<std::uint64_t>(s.loc[m.base]) + 7);
@@ -442,6 +475,7 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milesto
                                                const Resolution& res, int effort,
                                                const std::set<std::uint64_t>& excluded,
                                                const std::unordered_map<std::uint64_t, bool>& dead_ends,
+                                               const std::unordered_set<std::uint64_t>& forbidden,
                                                long long node_budget, std::vector<int>& path) {
   nodes_.clear();
   std::unordered_map<std::uint64_t, int> best_g;
@@ -475,6 +509,7 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milesto
       if (!dead_ends.empty() && dead_ends.contains(edge)) continue;
       const int g2 = g + 1;
       const std::uint64_t h2 = s2.Hash();
+      if (!forbidden.empty() && forbidden.contains(h2)) continue;
       auto [it, inserted] = best_g.try_emplace(h2, g2);
       if (!inserted) {
         if (it->second <= g2) continue;
@@ -581,9 +616,13 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
       std::vector<PlanAction> actions;
       std::unordered_map<std::uint64_t, bool> dead_ends;  // edges into abandoned states
       int root_failures = 0;
+      int round_failures = 0;
+      std::unordered_set<std::uint64_t> on_prefix;  // states the committed prefix visited
       while (!prefix.empty()) {
-        const SearchStatus status =
-            BestFirst(prefix.back().s, m, res, effort, excluded, dead_ends,
+        on_prefix.clear();
+        for (const Committed& p : prefix) on_prefix.insert(p.s.Hash());
+        SearchStatus status =
+            BestFirst(prefix.back().s, m, res, effort, excluded, dead_ends, on_prefix,
                       prefix.size() == 1 ? options_.max_nodes
                                          : std::min(options_.max_nodes, kLocalNodes),
                       path);
@@ -598,6 +637,10 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
           result.stopped = true;
           result.failure = "stopped";
           return result;
+        }
+        if (status == SearchStatus::kFound &&
+            static_cast<int>(prefix.size() - 1 + path.size()) > kMaxMilestoneActions) {
+          status = SearchStatus::kExhausted;  // too long: treat as a dead end
         }
         if (status != SearchStatus::kFound) {
           // Nothing from here: abandon this state.
@@ -645,6 +688,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
           actions.push_back(MakeAction(s, a, w->second, index));
           prefix.push_back({next, w->second.next, edge});
         }
+        if (!valid && ++round_failures > kRoundFailures) break;  // try more effort or width
         if (!valid && ++root_failures <= kRootFailures) {
           // Early on, search again from the milestone's start: shorter plans.
           prefix.resize(1);

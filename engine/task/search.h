@@ -10,6 +10,7 @@
 #include <set>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "core/run_context.h"
@@ -89,6 +90,7 @@ class TaskSearch {
   SearchStatus BestFirst(const SymState& s0, const Milestone& m, const Resolution& res, int effort,
                          const std::set<std::uint64_t>& excluded,
                          const std::unordered_map<std::uint64_t, bool>& dead_ends,
+                         const std::unordered_set<std::uint64_t>& forbidden,
                          long long node_budget, std::vector<int>& path);
   bool CheapPick(int robot, int node, int loc, int grasp);
   bool CheapPlace(int robot, int node, int loc, int grasp);
