@@ -23,7 +23,7 @@ constexpr int kWeight = 2;  // weighted best-first: f = g + 2 h
 constexpr long long kLocalNodes = 20000;
 // Validation failures after which the fill stops searching from the milestone's start and
 // commits to the validated prefix of its candidates.
-constexpr int kRootFailures = 40;
+constexpr int kRootFailures = 15;
 // Most actions in one milestone's plan: longer candidates count as dead ends.
 constexpr int kMaxMilestoneActions = 16;
 // Validation failures in one round (resolution and effort level) before moving to the next.
