@@ -13,7 +13,7 @@ JointVector HomeConfiguration(const Chain& chain) {
     const double elbow = 1.55;
     q << kPi, shoulder, elbow, -kPi / 2 - shoulder - elbow, -kPi / 2, 0.0;
   } else if (chain.name == "openarm" && chain.dof() == 7) {
-    q << 0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 1.3;
+    q << 0.0, -0.5, 0.0, 2.3, 0.0, 0.0, 0.6;
   }
   return ClampToLimits(chain, q);
 }

@@ -523,6 +523,83 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milesto
   return SearchStatus::kExhausted;
 }
 
+bool TaskSearch::AssemblyPossible(const Milestone& m, std::string* why) {
+  auto cached = possible_.find(m.step);
+  if (cached != possible_.end()) {
+    if (why) *why = cached->second.second;
+    return cached->second.first;
+  }
+  if (options_.wrench_mode == MatingWrenchMode::kNone) return true;
+  // One robot per end effector: the grasps a robot of that kind can take.
+  std::vector<int> kinds;
+  for (int r = 0; r < n_robots_; ++r) {
+    bool seen = false;
+    for (int k : kinds) seen = seen || world_.robots[k].grasp_set == world_.robots[r].grasp_set;
+    if (!seen) kinds.push_back(r);
+  }
+  constexpr int kMaxGrasps = 10;
+  auto grasps_of = [&](int node, int robot) {
+    std::vector<int> ids = GraspIds(node, robot);
+    if (static_cast<int>(ids.size()) > kMaxGrasps) ids.resize(kMaxGrasps);
+    return ids;
+  };
+  // The moved input held by one gripper, or by two.
+  std::vector<std::vector<std::pair<int, int>>> movers;
+  for (int r : kinds) {
+    for (int g : grasps_of(m.moved, r)) movers.push_back({{r, g}});
+  }
+  const size_t singles = movers.size();
+  for (size_t i = 0; i < singles; ++i) {
+    for (size_t j = i + 1; j < singles; ++j) {
+      if (GraspsApart(movers[i][0].second, movers[j][0].second)) {
+        movers.push_back({movers[i][0], movers[j][0]});
+      }
+    }
+  }
+  const auto& placements = world_.pre->subassemblies[m.base].placements;
+  const TableSlots& slots = world_.pre->table_slots;
+  std::string reason;
+  long long budget = 4000;  // LP questions before giving the search the benefit of the doubt
+  auto answer = [&](bool ok) {
+    possible_[m.step] = {ok, reason};
+    if (why) *why = reason;
+    return ok;
+  };
+  for (const auto& mh : movers) {
+    // The base in the air held by one gripper.
+    for (int r : kinds) {
+      for (int g : grasps_of(m.base, r)) {
+        if (--budget < 0) return answer(true);
+        std::string w;
+        const std::uint64_t key = HashMix(HashMix(HashMix(0xa551, m.step), mh[0].second),
+                                          HashMix(mh.size() > 1 ? mh[1].second : -1, g));
+        if (solver_.AirAssemblyPossible(m.step, mh, {{r, g}}, key, &w)) return answer(true);
+        if (reason.empty()) reason = w;
+      }
+    }
+    // The base resting on the table in each placement, alone or braced by one gripper.
+    if (slots.slots.empty()) continue;
+    for (size_t p = 0; p < placements.size(); ++p) {
+      const Iso3 X = PlacementPose(slots.slots[0], 0.0, placements[p]);
+      if (LowestPoint(world_, m.moved, X) < world_.table_top - 1e-3) continue;
+      const bool m_rests = std::abs(LowestPoint(world_, m.moved, X) - world_.table_top) <= 2e-3;
+      std::vector<std::vector<std::pair<int, int>>> braces{{}};
+      for (int r : kinds) {
+        for (int g : grasps_of(m.base, r)) braces.push_back({{r, g}});
+      }
+      for (const auto& bh : braces) {
+        if (--budget < 0) return answer(true);
+        const WrenchObject objs[2] = {{m.moved, X, m_rests, mh}, {m.base, X, true, bh}};
+        std::string w;
+        if (solver_.Wrench(WrenchGate::kAssembly, objs, m.step, 0, &w)) return answer(true);
+        if (reason.empty()) reason = w;
+      }
+    }
+  }
+  if (reason.empty()) reason = "no grasp of '" + world_.tree->nodes[m.moved].name + "'";
+  return answer(false);
+}
+
 PlanAction TaskSearch::MakeAction(const SymState& s, const TaskAction& a, const EdgeOutcome& e,
                                   int milestone) const {
   PlanAction p;
@@ -597,6 +674,16 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   }
   tally_ = GateTally{};
   MilestoneResult result;
+  if (std::string why; !AssemblyPossible(m, &why)) {
+    const StepInterface& st = world_.interface(step);
+    result.failure = "milestone " + std::to_string(index + 1) + " '" +
+                     world_.tree->nodes[step].name + "' (moving '" +
+                     world_.tree->nodes[st.moved].name + "' onto '" +
+                     world_.tree->nodes[st.base].name +
+                     "'): no combination of grasps and supports balances the mating wrench, "
+                     "whatever the robots' reach: " + why;
+    return result;
+  }
   const int levels = 3;
   std::vector<int> path;
   // The committed prefix: validated states from s0 on. The search starts from its last state;

@@ -96,6 +96,10 @@ class TaskSearch {
   bool CheapPlace(int robot, int node, int loc, int grasp);
   bool CheapAssemble(const SymState& s, const Milestone& m);
   bool GraspsApart(int grasp_a, int grasp_b) const;
+  /// Abstract check before a milestone: some grasps of the moved input (one or two) and some
+  /// support of the base (held by one gripper in some orientation, or resting in some
+  /// placement, alone or braced) balance the step's mating wrench. Cached per step.
+  bool AssemblyPossible(const Milestone& m, std::string* why);
   PlanAction MakeAction(const SymState& s, const TaskAction& a, const EdgeOutcome& e,
                         int milestone) const;
 
@@ -119,6 +123,7 @@ class TaskSearch {
   bool Recall(const CheapAnswer& answer);      // tallies a cached failure again
   void Remember(std::uint64_t key, bool ok);  // caches with the last tallied reason
   std::unordered_map<std::uint64_t, CheapAnswer> cheap_;  // cheap-check answers
+  std::map<int, std::pair<bool, std::string>> possible_;  // AssemblyPossible per step
   std::vector<Iso3> placement_pose_;                       // scratch
   long long expansions_ = 0;
   int widenings_ = 0;
