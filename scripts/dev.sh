@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's commands: install the dependencies, build, then run the demo or the tests.
 #   scripts/dev.sh demo   install, build, and run the main job on the built-in stool example:
-#                         validate, describe, preprocess and render snapshots into out/stool/
+#                         validate, describe, plan (validated) and render the plan's keyframes
+#                         and the goal into out/stool/
 #   scripts/dev.sh test   install, build, and run the whole test suite (what CI runs)
 #   scripts/dev.sh build  install and build only
 # BUILD_DIR (default: build) and BUILD_TYPE (default: RelWithDebInfo) may be set.
@@ -21,8 +22,10 @@ case "$mode" in
   demo)
     "$BUILD_DIR/app/wrap" validate projects/stool.json
     "$BUILD_DIR/app/wrap" info projects/stool.json
-    "$BUILD_DIR/app/wrap" render projects/stool.json -o out/stool --explode 0.4
     "$BUILD_DIR/app/wrap" preprocess projects/stool.json -o out/stool/preprocess.json
+    "$BUILD_DIR/app/wrap" plan projects/stool.json -o out/stool/plan.json --validate
+    "$BUILD_DIR/app/wrap" render projects/stool.json -o out/stool/plan --plan out/stool/plan.json
+    "$BUILD_DIR/app/wrap" render projects/stool.json -o out/stool --explode 0.4
     ;;
   test)
     ctest --test-dir "$BUILD_DIR" --output-on-failure --parallel "$(nproc)"

@@ -1,0 +1,100 @@
+// `wrap plan` through the CLI: the contract's exit codes, the words it prints and the plan file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+
+namespace wrap::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("wrap_plan_cli_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+TEST(PlanCli, PlansValidatesAndWritesThePlan) {
+  const fs::path dir = TempDir("stool");
+  const fs::path out = dir / "plan.json";
+  const CliRun r = Wrap({"plan", Project("half_stool"), "-o", out.string(), "--validate"});
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("Solved: cost"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1. "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("assembles 'leg1' onto 'seat'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Validated:"), std::string::npos) << r.out;
+  std::ifstream in(out);
+  const nlohmann::json plan = nlohmann::json::parse(in);
+  EXPECT_EQ(plan["format"], "wrap-plan");
+  EXPECT_TRUE(plan["stats"]["solved"].get<bool>());
+  EXPECT_EQ(plan["stats"]["cost"].get<int>(), static_cast<int>(plan["actions"].size()));
+  for (const char* key : {"t_init_s", "t_grasp_s", "t_bwd_s", "t_lp_s", "t_fwd_s", "t_ik_s"}) {
+    EXPECT_TRUE(plan["stats"].contains(key)) << key;
+  }
+  EXPECT_EQ(plan["stats"]["planner"], "counting");
+  EXPECT_EQ(plan["stats"]["seed"].get<int>(), 0);
+  ASSERT_FALSE(plan["actions"].empty());
+  EXPECT_TRUE(plan["actions"][0].contains("keyframe"));
+  EXPECT_TRUE(plan["actions"][0]["keyframe"]["q"].contains("left"));
+}
+
+TEST(PlanCli, SeedAndWrenchModeReachTheStats) {
+  const fs::path dir = TempDir("seed");
+  const fs::path out = dir / "plan.json";
+  const CliRun r = Wrap({"plan", Project("half_stool"), "-o", out.string(), "--seed", "5",
+                         "--wrench", "gravity", "--force-scale", "0.5"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(out);
+  const nlohmann::json plan = nlohmann::json::parse(in);
+  EXPECT_EQ(plan["stats"]["seed"].get<int>(), 5);
+  EXPECT_EQ(plan["stats"]["wrench_mode"], "gravity");
+  EXPECT_DOUBLE_EQ(plan["stats"]["force_scale"].get<double>(), 0.5);
+}
+
+TEST(PlanCli, BadInputExitsTwo) {
+  EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--wrench", "strong"}).code, 2);
+  EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--force-scale", "-1"}).code, 2);
+  EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--time-limit", "0"}).code, 2);
+  EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--planner", "magic"}).code, 2);
+  const CliRun missing = Wrap({"plan", "/nonexistent/project.json"});
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("project.json"), std::string::npos) << missing.err;
+}
+
+TEST(PlanCli, UnwritableOutputLeavesNothingAndExitsTwo) {
+  const fs::path dir = TempDir("unwritable");
+  const fs::path out = dir / "no_such_folder" / "plan.json";
+  const CliRun r = Wrap({"plan", Project("half_stool"), "-o", out.string()});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// Only vacuum cups and a step that needs transverse force: exit 1 naming the step.
+TEST(PlanCli, InfeasibleProjectExitsOneNamingTheStep) {
+  const fs::path dir = TempDir("infeasible");
+  std::ifstream in(Project("stool"));
+  nlohmann::ordered_json p = nlohmann::ordered_json::parse(in);
+  for (auto& robot : p["robots"]) robot["end_effector"] = "vacuum_cup";
+  p["steps"][0]["mating"]["transverse_fraction"] = 0.5;
+  p["steps"][0]["mating"]["offset_m"] = 0.01;
+  // Meshes are relative to the project file: point them back at the repository.
+  for (auto& part : p["parts"]) {
+    part["mesh"] = (fs::path(Project("stool")).parent_path() / part["mesh"].get<std::string>())
+                       .lexically_normal()
+                       .string();
+  }
+  const fs::path file = dir / "vacuum_stool.json";
+  std::ofstream(file) << p.dump(2);
+  const CliRun r = Wrap({"plan", file.string(), "--time-limit", "120"});
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_NE(r.err.find("seat+leg1"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("vacuum"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace wrap::cli
