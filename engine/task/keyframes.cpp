@@ -698,7 +698,7 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
       candidates.push_back(std::move(Xk));
     }
     std::stable_sort(scored.begin(), scored.end(),
-                     [](const auto& a, const auto& b) { return a.first > b.first; });
+                     [](const auto& x, const auto& y) { return x.first > y.first; });
     std::vector<std::vector<Iso3>> ordered;
     for (int i = 0; i < static_cast<int>(scored.size()) && i < n_candidates; ++i) {
       ordered.push_back(std::move(candidates[scored[i].second]));

@@ -1,6 +1,8 @@
 #include "task/planner.h"
 
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <set>
 
@@ -106,7 +108,8 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
                 "' was being planned";
       break;
     }
-    if (failure.empty() || k >= 0) failure = r.failure;
+    failure = r.failure;
+    if (std::getenv("WRAP_TASK_DEBUG")) std::fprintf(stderr, "[task] %s\n", failure.c_str());
     if (k > 0 && backtracks < options.max_backtracks) {
       excluded[k - 1].insert(results[k - 1].end.Hash());
       excluded[k].clear();

@@ -308,9 +308,9 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
     const bool m_touches = std::abs(LowestPoint(world_, m.moved, X_WB) - world_.table_top) <= 2e-3;
     for (const auto& [r, g] : mh) {
       if (!ok) break;
-      std::string why;
-      ok = solver_.SoloReach(r, {{m.moved, X_WB, m_touches}, {m.base, X_WB, true}}, g, &why);
-      if (!ok) tally_.Add(Gate::kIk, why + " to insert '" + world_.tree->nodes[m.moved].name + "'");
+      std::string solo;
+      ok = solver_.SoloReach(r, {{m.moved, X_WB, m_touches}, {m.base, X_WB, true}}, g, &solo);
+      if (!ok) tally_.Add(Gate::kIk, solo + " to insert '" + world_.tree->nodes[m.moved].name + "'");
     }
     if (ok && LowestPoint(world_, m.moved, X_WB) < world_.table_top - 1e-3) {
       ok = false;
