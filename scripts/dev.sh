@@ -22,6 +22,7 @@ case "$mode" in
   demo)
     "$BUILD_DIR/app/wrap" validate projects/stool.json
     "$BUILD_DIR/app/wrap" info projects/stool.json
+    mkdir -p out/stool
     "$BUILD_DIR/app/wrap" preprocess projects/stool.json -o out/stool/preprocess.json
     "$BUILD_DIR/app/wrap" plan projects/stool.json -o out/stool/plan.json --validate
     "$BUILD_DIR/app/wrap" render projects/stool.json -o out/stool/plan --plan out/stool/plan.json
