@@ -104,8 +104,9 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
     }
     if (r.stopped) {
       stopped = true;
-      failure = "milestone " + std::to_string(k + 1) + " '" + world.tree->nodes[order[k]].name +
-                "' was being planned";
+      failure = "milestone " + std::to_string(k + 1) + "/" + std::to_string(K) + " '" +
+                world.tree->nodes[order[k]].name + "' was being planned; checks that failed most: " +
+                r.failure;
       break;
     }
     failure = r.failure;

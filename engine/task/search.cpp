@@ -43,12 +43,15 @@ void GateTally::Add(Gate gate, const std::string& message) {
   last_message = message;
 }
 
-bool TaskSearch::Recall(const CheapAnswer& answer) {
-  if (!answer.ok) tally_.Add(answer.gate, answer.why);
+bool TaskSearch::Recall(std::uint64_t key, const CheapAnswer& answer) {
+  // Counted once per milestone: the tally counts distinct questions, not how often the search
+  // met them.
+  if (!answer.ok && tallied_.insert(key).second) tally_.Add(answer.gate, answer.why);
   return answer.ok;
 }
 
 void TaskSearch::Remember(std::uint64_t key, bool ok) {
+  tallied_.insert(key);
   cheap_[key] = ok ? CheapAnswer{} : CheapAnswer{false, tally_.last_gate, tally_.last_message};
 }
 
@@ -195,7 +198,7 @@ SymState TaskSearch::Apply(const SymState& s, const TaskAction& a) const {
 
 bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
   std::uint64_t key = HashMix(HashMix(HashMix(HashMix(101, robot), node), loc), grasp);
-  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(it->second);
+  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(key, it->second);
   const Iso3 X_WA = tables_.location(loc).X_WA;
   const Iso3 target = solver_.GraspTarget(X_WA, grasp);
   bool ok = solver_.InReach(robot, target);
@@ -228,7 +231,7 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
 
 bool TaskSearch::CheapPlace(int robot, int node, int loc, int grasp) {
   std::uint64_t key = HashMix(HashMix(HashMix(HashMix(102, robot), node), loc), grasp);
-  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(it->second);
+  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(key, it->second);
   const Iso3 X_WA = tables_.location(loc).X_WA;
   const Iso3 target = solver_.GraspTarget(X_WA, grasp);
   bool ok = solver_.InReach(robot, target);
@@ -267,7 +270,7 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
   for (const auto& [r, g] : mh) key = HashMix(HashMix(key, r), g);
   key = HashMix(key, 999);
   for (const auto& [r, g] : bh) key = HashMix(HashMix(key, r), g);
-  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(it->second);
+  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(key, it->second);
   bool ok = true;
   std::string why;
   // Context-free: no gripper may touch the other input at the mating pose.
@@ -673,6 +676,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
     m.keep[1] = world_.interface(next_step).base;
   }
   tally_ = GateTally{};
+  tallied_.clear();
   MilestoneResult result;
   if (std::string why; !AssemblyPossible(m, &why)) {
     const StepInterface& st = world_.interface(step);
@@ -722,7 +726,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
         }
         if (status == SearchStatus::kStopped) {
           result.stopped = true;
-          result.failure = "stopped";
+          result.failure = tally_.Summary();
           return result;
         }
         if (status == SearchStatus::kFound &&
@@ -742,7 +746,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
         for (int node_index : path) {
           if (ctx_.ShouldStop()) {
             result.stopped = true;
-            result.failure = "stopped";
+            result.failure = tally_.Summary();
             return result;
           }
           const SymState& s = prefix.back().s;

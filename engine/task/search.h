@@ -120,9 +120,10 @@ class TaskSearch {
     Gate gate = Gate::kNone;
     std::string why;
   };
-  bool Recall(const CheapAnswer& answer);      // tallies a cached failure again
+  bool Recall(std::uint64_t key, const CheapAnswer& answer);  // tallies a cached failure once
   void Remember(std::uint64_t key, bool ok);  // caches with the last tallied reason
   std::unordered_map<std::uint64_t, CheapAnswer> cheap_;  // cheap-check answers
+  std::unordered_set<std::uint64_t> tallied_;  // cheap failures tallied in this milestone
   std::map<int, std::pair<bool, std::string>> possible_;  // AssemblyPossible per step
   std::vector<Iso3> placement_pose_;                       // scratch
   long long expansions_ = 0;
