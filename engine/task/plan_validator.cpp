@@ -604,6 +604,14 @@ void Validator::CheckCollisions(int index, const std::string& label, const Keyfr
     if (object_of[p] >= 0) {
       const int node = object_of[p];
       touches = m.rest_check.count(node) > 0;
+      // Any object may touch the table top from above (e.g. a moved input that slides along the
+      // table into a resting base, or reaches down to the top when mated), never sink into it.
+      double lowest = std::numeric_limits<double>::infinity();
+      for (int q : tree_.nodes[node].parts) {
+        const Iso3 X_WP = X_WA.at(node) * X_AP_[q];
+        for (const Vec3& v : hull_P_[q]) lowest = std::min(lowest, (X_WP * v).z());
+      }
+      touches = touches || std::abs(lowest - project_.table.height) <= options_.table_tolerance_m;
       if (auto it = objects_.find(node); it != objects_.end() && it->second.at_rest_pose) {
         const PoseError e = Difference(it->second.X_WA, X_WA.at(node));
         touches = touches || (e.position_m <= options_.position_tolerance_m &&

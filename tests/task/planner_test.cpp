@@ -93,7 +93,7 @@ TEST_P(ExamplePlan, IsSolvedAndValid) {
 
 INSTANTIATE_TEST_SUITE_P(Projects, ExamplePlan,
                          ::testing::Values("stool", "half_stool", "chair", "cross",
-                                           "fabrica_plumbers_block"),
+                                           "fabrica_plumbers_block", "fabrica_beam"),
                          [](const auto& info) { return info.param; });
 
 // The cross with 2 and 3 of its 4 robots (the paper's scaling in robots).
