@@ -8,11 +8,10 @@
 
 #include "grasp/detail/parallel.h"
 #include "model/catalog.h"
-#include "model/paths.h"
 #include "model/validate.h"
 #include "robot/catalog.h"
 #include "robot/ik.h"
-#include "robot/urdf_import.h"
+#include "robot/project_chain.h"
 
 namespace wrap {
 
@@ -30,23 +29,11 @@ struct ReachRobot {
 Result<ReachRobot> LoadReachRobot(const Project& project, const std::filesystem::path& file,
                                   const Robot& robot) {
   ReachRobot out;
-  if (!robot.model.empty()) {
-    auto chain = LoadRobotModel(robot.model);
-    if (!chain) return std::unexpected(chain.error());
-    out.chain = std::move(*chain);
-    if (const RobotModelInfo* info = FindRobotModel(robot.model)) {
-      out.reach_m = info->reach_m + 0.05;  // the catalog's flange reach, plus a little slack
-    }
-  } else {
-    auto resolved = ResolveProjectPath(project, file, robot.urdf);
-    if (!resolved) return std::unexpected(resolved.error());
-    UrdfImportOptions options;
-    options.root = robot.urdf_root;
-    options.tip = robot.urdf_tip;
-    options.import_visual = false;
-    auto chain = ImportUrdf(resolved->path, options);
-    if (!chain) return std::unexpected(chain.error());
-    out.chain = std::move(*chain);
+  auto chain = LoadProjectChain(project, robot, file, false);
+  if (!chain) return std::unexpected(chain.error());
+  out.chain = std::move(*chain);
+  if (const RobotModelInfo* info = robot.model.empty() ? nullptr : FindRobotModel(robot.model)) {
+    out.reach_m = info->reach_m + 0.05;  // the catalog's flange reach, plus a little slack
   }
   auto ee = LoadEndEffector(robot.end_effector);
   if (!ee) return std::unexpected(ee.error());

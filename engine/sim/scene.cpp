@@ -5,9 +5,8 @@
 #include <map>
 #include <numbers>
 
-#include "model/paths.h"
 #include "robot/home.h"
-#include "robot/urdf_import.h"
+#include "robot/project_chain.h"
 
 namespace wrap {
 
@@ -66,15 +65,6 @@ void PlacePedestal(const SceneTable& table, SceneRobot& robot) {
   robot.pedestal_bottom_z = bottom;
 }
 
-Result<Chain> LoadChain(const Project& project, const Robot& r, const fs::path& project_file) {
-  if (!r.model.empty()) return LoadRobotModel(r.model);
-  auto resolved = ResolveProjectPath(project, project_file, r.urdf);
-  if (!resolved) return std::unexpected(resolved.error());
-  UrdfImportOptions options;
-  options.root = r.urdf_root;
-  options.tip = r.urdf_tip;
-  return ImportUrdf(resolved->path, options);
-}
 
 // Pose of every part in the assembly frame A after exploding: each step moves the parts of its
 // moved input back along its insertion axis by `distance` [m].
@@ -145,7 +135,7 @@ Result<CellScene> BuildCellScene(const Project& project, const ProjectCheck& che
   }
 
   for (const Robot& r : project.robots) {
-    auto chain = LoadChain(project, r, project_file);
+    auto chain = LoadProjectChain(project, r, project_file);
     if (!chain) {
       return Fail(ErrorCode::kInvalidInput,
                   "scene: robot '" + r.name + "': " + chain.error().message);

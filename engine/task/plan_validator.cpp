@@ -4,6 +4,8 @@
 // not repeated here. See plan_validator.h for what is checked and task/plan.h for the contract.
 #include "task/plan_validator.h"
 
+#include "robot/project_chain.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -15,12 +17,12 @@
 #include <utility>
 
 #include "geometry/convex_hull.h"
-#include "model/paths.h"
 #include "robot/catalog.h"
 #include "robot/cell.h"
 #include "robot/home.h"
 #include "robot/kinematics.h"
-#include "robot/urdf_import.h"
+#include "robot/project_chain.h"
+#include "robot/project_chain.h"
 
 namespace wrap {
 
@@ -232,21 +234,9 @@ Result<RobotModel> LoadRobot(const Project& project, const Robot& robot,
                              const std::filesystem::path& project_file) {
   RobotModel m;
   m.name = robot.name;
-  if (!robot.model.empty()) {
-    auto chain = LoadRobotModel(robot.model);
-    if (!chain) return std::unexpected(chain.error());
-    m.chain = std::move(*chain);
-  } else {
-    auto resolved = ResolveProjectPath(project, project_file, robot.urdf);
-    if (!resolved) return std::unexpected(resolved.error());
-    UrdfImportOptions options;
-    options.root = robot.urdf_root;
-    options.tip = robot.urdf_tip;
-    options.import_visual = false;
-    auto chain = ImportUrdf(resolved->path, options);
-    if (!chain) return std::unexpected(chain.error());
-    m.chain = std::move(*chain);
-  }
+  auto chain = LoadProjectChain(project, robot, project_file, false);
+  if (!chain) return std::unexpected(chain.error());
+  m.chain = std::move(*chain);
   auto ee = LoadEndEffector(robot.end_effector);
   if (!ee) return std::unexpected(ee.error());
   m.ee = std::move(*ee);

@@ -5,25 +5,15 @@
 #include <limits>
 #include <random>
 
-#include "model/paths.h"
 #include "robot/home.h"
+#include "robot/project_chain.h"
 #include "robot/kinematics.h"
-#include "robot/urdf_import.h"
 
 namespace wrap {
 namespace {
 
 namespace fs = std::filesystem;
 
-Result<Chain> LoadTaskChain(const Project& project, const Robot& r, const fs::path& project_file) {
-  if (!r.model.empty()) return LoadRobotModel(r.model);
-  auto resolved = ResolveProjectPath(project, project_file, r.urdf);
-  if (!resolved) return std::unexpected(resolved.error());
-  UrdfImportOptions options;
-  options.root = r.urdf_root;
-  options.tip = r.urdf_tip;
-  return ImportUrdf(resolved->path, options);
-}
 
 // Reach sphere of a robot: centre at the mean TCP position of random configurations projected
 // on the first joint axis (the shoulder), radius the largest TCP distance from it.
@@ -259,7 +249,7 @@ Result<TaskWorld> BuildTaskWorld(const Project& project, const ProjectCheck& che
   for (const Robot& r : project.robots) {
     TaskRobot robot;
     robot.name = r.name;
-    auto chain = LoadTaskChain(project, r, project_file);
+    auto chain = LoadProjectChain(project, r, project_file, false);
     if (!chain) {
       return Fail(ErrorCode::kInvalidInput,
                   "planner: robot '" + r.name + "': " + chain.error().message);

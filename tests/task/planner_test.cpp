@@ -94,7 +94,7 @@ TEST_P(ExamplePlan, IsSolvedAndValid) {
 INSTANTIATE_TEST_SUITE_P(Projects, ExamplePlan,
                          ::testing::Values("stool", "half_stool", "chair", "cross",
                                            "fabrica_plumbers_block", "fabrica_beam"),
-                         [](const auto& info) { return info.param; });
+                         [](const auto& param_info) { return param_info.param; });
 
 // The cross with 2 and 3 of its 4 robots (the paper's scaling in robots).
 class CrossRobots : public ::testing::TestWithParam<int> {};
@@ -118,7 +118,7 @@ TEST_P(CrossRobots, IsSolvedAndValid) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Counts, CrossRobots, ::testing::Values(2, 3),
-                         [](const auto& info) { return std::to_string(info.param) + "_robots"; });
+                         [](const auto& param_info) { return std::to_string(param_info.param) + "_robots"; });
 
 // Same project, options and seed: the same plan, keyframes included.
 TEST(PlannerDeterminism, SameSeedSamePlan) {
