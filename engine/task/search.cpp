@@ -88,7 +88,7 @@ TaskSearch::Resolution TaskSearch::ResolutionAt(int level) const {
   constexpr int kGrasps[] = {6, 12, 1 << 20};
   constexpr int kPlacements[] = {2, 4, 1 << 20};
   constexpr int kSlots[] = {3, 6, 1 << 20};
-  constexpr int kYaws[] = {2, 4, 1 << 20};
+  constexpr int kYaws[] = {2, 2, 1 << 20};
   Resolution r;
   r.grasps = widen_ ? kGrasps[level] : 1 << 20;
   r.placements = kPlacements[level];
