@@ -11,12 +11,6 @@ namespace wrap::cli {
 
 namespace {
 
-std::string Fmt(const char* format, double a) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, a);
-  return buf;
-}
-
 std::string Pad(std::string s, size_t width) {
   if (s.size() < width) s.append(width - s.size(), ' ');
   return s;
@@ -68,13 +62,7 @@ void PrintNode(const Project& p, const AssemblyTree& tree, int id, const std::st
 
 int Info(const std::string& project, std::ostream& out, std::ostream& err) {
   const LoadedProject loaded = LoadChecked(project);
-  const Diagnostics& diags = loaded.check.diagnostics;
-  if (!loaded.ok()) {
-    for (const Diagnostic& d : diags.items) err << Format(d) << "\n";
-    err << project << ": invalid: " << diags.error_count() << " error(s); run 'wrap validate'\n";
-    return 2;
-  }
-  for (const Diagnostic& d : diags.items) err << Format(d) << "\n";
+  if (!ReportLoad(loaded, project, err)) return 2;
   const Project& p = *loaded.project;
   const ProjectCheck& check = loaded.check;
 

@@ -11,16 +11,6 @@
 
 namespace wrap::cli {
 
-namespace {
-
-std::string Fmt(const char* format, double a) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, a);
-  return buf;
-}
-
-}  // namespace
-
 int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   TaskPlannerOptions options;
   options.project_file = args.project;
@@ -46,13 +36,7 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   }
 
   const LoadedProject loaded = LoadChecked(args.project);
-  const Diagnostics& diags = loaded.check.diagnostics;
-  for (const Diagnostic& d : diags.items) err << Format(d) << "\n";
-  if (!loaded.ok()) {
-    err << args.project << ": invalid: " << diags.error_count()
-        << " error(s); run 'wrap validate'\n";
-    return 2;
-  }
+  if (!ReportLoad(loaded, args.project, err)) return 2;
   const Project& p = *loaded.project;
   const std::uint64_t seed = args.seed.value_or(p.planner.seed);
   const double time_limit = args.time_limit.value_or(p.planner.time_limit_s);

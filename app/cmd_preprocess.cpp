@@ -14,12 +14,6 @@ namespace wrap::cli {
 
 namespace {
 
-std::string Fmt(const char* format, double a) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, a);
-  return buf;
-}
-
 void PrintSubassembly(const Project& p, const Subassembly& s, std::ostream& out) {
   out << "  " << s.name << "  (" << s.parts.size() << (s.parts.size() == 1 ? " part" : " parts");
   if (s.parts.size() > 1) {
@@ -46,13 +40,7 @@ void PrintSubassembly(const Project& p, const Subassembly& s, std::ostream& out)
 
 int Preprocess(const PreprocessArgs& args, std::ostream& out, std::ostream& err) {
   const LoadedProject loaded = LoadChecked(args.project);
-  const Diagnostics& diags = loaded.check.diagnostics;
-  for (const Diagnostic& d : diags.items) err << Format(d) << "\n";
-  if (!loaded.ok()) {
-    err << args.project << ": invalid: " << diags.error_count()
-        << " error(s); run 'wrap validate'\n";
-    return 2;
-  }
+  if (!ReportLoad(loaded, args.project, err)) return 2;
   const Project& p = *loaded.project;
   PreprocessOptions options;
   options.project_file = args.project;

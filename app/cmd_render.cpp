@@ -155,12 +155,7 @@ int Render(const RenderArgs& args, std::ostream& out, std::ostream& err) {
   if (auto ok = render::PrepareOutputDirectory(job.out_dir); !ok) return Report(ok.error(), err);
 
   const LoadedProject loaded = LoadChecked(args.project);
-  if (!loaded.ok()) {
-    for (const Diagnostic& d : loaded.check.diagnostics.items) err << Format(d) << "\n";
-    err << args.project << ": invalid: " << loaded.check.diagnostics.error_count()
-        << " error(s); run 'wrap validate'\n";
-    return 2;
-  }
+  if (!ReportLoad(loaded, args.project, err, /*warnings=*/false)) return 2;
   auto scene = BuildCellScene(*loaded.project, loaded.check, args.project);
   if (!scene) return Report(scene.error(), err);
 

@@ -1,6 +1,8 @@
 // Loading a project for a subcommand: parse, validate, and check robots against the catalog.
 #pragma once
 
+#include <iosfwd>
+
 #include <string>
 
 #include "model/validate.h"
@@ -9,5 +11,14 @@ namespace wrap::cli {
 
 /// The model's LoadProject plus the robot stage's CheckRobots (URDFs import, catalog loads).
 LoadedProject LoadChecked(const std::string& project);
+
+/// Prints the load's diagnostics to `err` (all of them, or with `warnings` false only when the
+/// project is invalid) and, when it is invalid, a line saying so. Returns loaded.ok(): false
+/// means the subcommand exits 2.
+bool ReportLoad(const LoadedProject& loaded, const std::string& project, std::ostream& err,
+                bool warnings = true);
+
+/// printf-style formatting of one number, e.g. Fmt("%.2f", 1.5).
+std::string Fmt(const char* format, double value);
 
 }  // namespace wrap::cli
