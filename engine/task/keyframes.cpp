@@ -622,11 +622,7 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
                                       {B, X[B], b_rests, b_holders}};
         std::uint64_t key = 0;
         if (b_rests) {
-          key = HashMix(3, static_cast<std::uint64_t>(o));
-          key = HashMix(key, static_cast<std::uint64_t>(s.loc[B]) + 7);
-          for (const auto& [r, gr] : m_holders) key = HashMix(HashMix(key, r), gr);
-          key = HashMix(key, 999);
-          for (const auto& [r, gr] : b_holders) key = HashMix(HashMix(key, r), gr);
+          key = AssemblyLpKey(o, s.loc[B], m_holders, b_holders);
         }
         if (!Wrench(WrenchGate::kAssembly, objs, o, key, &why)) {
           g = Gate::kWrenchAssembly;

@@ -324,12 +324,8 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
     if (ok) {
       const bool m_rests = std::abs(LowestPoint(world_, m.moved, X_WB) - world_.table_top) <= 2e-3;
       const WrenchObject objs[2] = {{m.moved, X_WB, m_rests, mh}, {m.base, X_WB, true, bh}};
-      std::uint64_t lp_key = HashMix(3, static_cast<std::uint64_t>(m.step));
-      lp_key = HashMix(lp_key, static_cast<std::uint64_t>(s.loc[m.base]) + 7);
-      for (const auto& [r, g] : mh) lp_key = HashMix(HashMix(lp_key, r), g);
-      lp_key = HashMix(lp_key, 999);
-      for (const auto& [r, g] : bh) lp_key = HashMix(HashMix(lp_key, r), g);
-      ok = solver_.Wrench(WrenchGate::kAssembly, objs, m.step, lp_key, &why);
+      ok = solver_.Wrench(WrenchGate::kAssembly, objs, m.step,
+                          AssemblyLpKey(m.step, s.loc[m.base], mh, bh), &why);
       if (!ok) tally_.Add(Gate::kWrenchAssembly, why);
     }
   } else {

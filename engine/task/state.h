@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <map>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "core/pose.h"
@@ -91,6 +92,20 @@ inline std::uint64_t HashMix(std::uint64_t h, std::uint64_t v) {
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
   x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
   return x ^ (x >> 31);
+}
+
+/// Cache key of the assembly LP of `step` with the base resting at location `base_loc`, the moved
+/// input held by `moved_holders` and the base by `base_holders` ((robot, grasp id) pairs): the
+/// expansion's cheap check and the edge validation ask the same question under this key.
+inline std::uint64_t AssemblyLpKey(int step, int base_loc,
+                                   const std::vector<std::pair<int, int>>& moved_holders,
+                                   const std::vector<std::pair<int, int>>& base_holders) {
+  std::uint64_t key = HashMix(3, static_cast<std::uint64_t>(step));
+  key = HashMix(key, static_cast<std::uint64_t>(base_loc) + 7);
+  for (const auto& [r, g] : moved_holders) key = HashMix(HashMix(key, r), g);
+  key = HashMix(key, 999);
+  for (const auto& [r, g] : base_holders) key = HashMix(HashMix(key, r), g);
+  return key;
 }
 
 }  // namespace wrap
