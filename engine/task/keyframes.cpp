@@ -211,6 +211,7 @@ bool KeyframeSolver::SoloReach(int robot, const std::vector<PlanObject>& objects
   return ok;
 }
 
+
 bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objects,
                             int mating_step, std::uint64_t key, std::string* reason) {
   if (options_.wrench_mode == MatingWrenchMode::kNone) return true;
@@ -822,13 +823,18 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
       for (int node : keyframe_nodes) objs_a.push_back({node, Xa[node], keyframe_resting[node]});
       SetScene(objs_a, holds_at_keyframe, -1, -1);
       for (size_t i = 0; i < movers.size(); ++i) SetRobot(movers[i].robot, qa[i]);
-      const bool hit = Collides();
+      bool hit = Collides();
+      if (!hit && n_robots >= 2) {  // The robots' clearance holds at the approach too.
+        DistanceRequest request;
+        request.upper_bound_m = options_.min_clearance_m * 2 + 0.01;
+        hit = cell_.MinRobotClearance(request).distance < options_.min_clearance_m;
+      }
       // Restore the mated scene for the search to go on.
       SetScene(objects, holds_at_keyframe, allow_a, allow_b);
       for (size_t i = 0; i < movers.size(); ++i) SetRobot(movers[i].robot, q[i]);
       if (hit) {
         search_gate = Gate::kApproach;
-        leaf_message = "the insertion approach collides";
+        leaf_message = "the insertion approach collides or brings robots within the clearance";
         return false;
       }
       Keyframe kf;

@@ -1166,7 +1166,9 @@ void Validator::ReplayAction(int i) {
 
       StepConfiguration config;
       std::vector<int> body(project_.parts.size(), -1);
-      AddObject(M, X.at(M), objects_[M].holders, false, config, body);
+      // The moved input rests on the table where it touches it (a part slid along the table
+      // into a resting base): its parts that reach the top get their support polygons.
+      AddObject(M, X.at(M), objects_[M].holders, true, config, body);
       AddObject(B, X.at(B), objects_[B].holders, objects_[B].resting, config, body);
       if (f.moved_part >= 0 && body[f.moved_part] >= 0 && body[f.base_part] >= 0) {
         config.mating = MatingLoadFromProject(f.step->mating, X.at(B), body[f.moved_part],

@@ -21,9 +21,26 @@
 // (the table, infinite bounds) carry the whole load: utilisation 0, and a second LP with s = 1 and
 // every finite bound scaled to 0 returns such a balancing wrench.
 //
+// Grippers whose assembly box differs from their transport box (a vacuum cup: only its axial
+// force while mating, paper table of limits). Before the parts touch, the grippers already hold
+// their weight, as in transport; the paper's assembly box bounds what the insertion adds, since
+// it is the insertion's transverse load that deflects a cup. Such a step is checked in two
+// stages ("held, then mated"): first the gravity-only LP with transport limits gives the holding
+// wrenches h (the minimised largest utilisation, h = x / s); then, per vertex of the mating set
+// without gravity, the load-factor LP above over increments m with
+//     vacuum components:   max(assembly lower, transport lower - h) <= m <= min(assembly upper,
+//                          transport upper - h)
+//     other grippers and connections: lower - h <= m <= upper - h
+//     table generators:    m >= -h (the total coefficient stays >= 0),
+// so every total h + m lies within its limits. s then scales the mating load alone; a vertex's
+// utilisation is the largest |h + m / s| / limit over grippers and connections when s >= 1,
+// else 1 / s. With h fixed the check is conservative (a different holding split could leave
+// more room); configurations whose grippers have one box for both modes take the single LP.
+//
 // Robust satisfaction: feasible iff every vertex has s >= 1 - tolerance. Each support reports the
 // largest utilisation over the vertices; a table reports the friction its resultant force uses,
 // |F_t| / (mu F_n). When infeasible, explain.cpp names the binding limits at the worst vertex.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
@@ -69,6 +86,20 @@ struct WrenchChecker::Impl {
   std::uint64_t misses = 0;
 
   Result<WrenchCheck> Compute(const StepConfiguration& config, const WrenchQuery& query);
+  // The variant of `problem` with s = 1 and every finite bound at 0 (the load factor was
+  // unbounded: unlimited supports carry the load); its solution into `solution`.
+  Result<void> SolveAtZeroUtilisation(int n);
+  // The "held, then mated" assembly check (see the top of this file); `out` has its supports.
+  Result<WrenchCheck> ComputeHeldThenMated(const StepConfiguration& config,
+                                           const WrenchQuery& query, WrenchCheck out);
+  // Columns of every support of an assembly check (grippers with their transport components);
+  // fills columns, support_of, edge, lower, upper (the total bounds) and problem's columns.
+  void BuildColumns(const StepConfiguration& config, WrenchGate gate, const Vec3& p_WO,
+                    bool transport_boxes);
+  // Finishes `out` from the vertex loop's results: worst-vertex label, explanation, reason.
+  Result<WrenchCheck> Finish(const StepConfiguration& explain_config, const WrenchQuery& query,
+                             const Vec3& p_WO, const detail::VertexSet& set, WrenchCheck out,
+                             const std::string& prefix);
   // Utilisations of one vertex's solution x (actual loads = x * scale) into `out`.
   void Accumulate(const StepConfiguration& config, const std::vector<double>& x, double scale,
                   int vertex, WrenchCheck& out);
@@ -116,28 +147,13 @@ void WrenchChecker::Impl::Accumulate(const StepConfiguration& config, const std:
   }
 }
 
-Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config,
-                                                 const WrenchQuery& query) {
-  if (auto valid = detail::Validate(config, query); !valid) return std::unexpected(valid.error());
-  const WrenchGate gate = query.gate;
+void WrenchChecker::Impl::BuildColumns(const StepConfiguration& config, WrenchGate gate,
+                                       const Vec3& p_WO, bool transport_boxes) {
   const bool grippers_on = detail::GrippersActive(gate);
   const bool tables_on = detail::TablesActive(gate);
   const int ng = static_cast<int>(config.grippers.size());
   const int nc = static_cast<int>(config.connections.size());
   const int nt = static_cast<int>(config.tables.size());
-
-  WrenchCheck out;
-  if (grippers_on) {
-    for (int g = 0; g < ng; ++g) out.supports.push_back({SupportKind::kGripper, g});
-  }
-  for (int c = 0; c < nc; ++c) out.supports.push_back({SupportKind::kConnection, c});
-  if (tables_on) {
-    for (int t = 0; t < nt; ++t) out.supports.push_back({SupportKind::kTable, t});
-  }
-  if (query.mode == MatingWrenchMode::kNone) return out;
-
-  // Columns: every gripper and connection component that can carry load, every table generator.
-  const Vec3 p_WO = detail::ReferencePoint(config);
   const int rows = static_cast<int>(config.bodies.size()) * 6;
   columns.clear();
   support_of.clear();
@@ -153,7 +169,9 @@ Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config
   };
   if (grippers_on) {
     for (int g = 0; g < ng; ++g) {
-      add_limited(SupportKind::kGripper, g, detail::GripperLimits(config.grippers[g], gate),
+      const WrenchGripper& gr = config.grippers[g];
+      add_limited(SupportKind::kGripper, g,
+                  transport_boxes ? gr.transport_limits : detail::GripperLimits(gr, gate),
                   gripper_base + g);
     }
   }
@@ -183,6 +201,10 @@ Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config
     if (c.kind == SupportKind::kTable) {
       const WrenchTableSupport& table = config.tables[c.owner];
       edge[j] = detail::PyramidEdge(table, c.component % detail::PyramidEdges(table));
+    } else if (transport_boxes && c.kind == SupportKind::kGripper) {
+      const WrenchBounds& b = config.grippers[c.owner].transport_limits;
+      lower[j] = b.lower[c.component];
+      upper[j] = b.upper[c.component];
     } else {
       detail::ComponentBounds(config, gate, c, lower[j], upper[j]);
     }
@@ -192,6 +214,79 @@ Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config
   problem.cost[n] = -1.0;  // Maximise s.
   problem.lower[n] = 0.0;
   problem.upper[n] = kInf;
+}
+
+Result<WrenchCheck> WrenchChecker::Impl::Finish(const StepConfiguration& explain_config,
+                                                const WrenchQuery& query, const Vec3& p_WO,
+                                                const detail::VertexSet& set, WrenchCheck out,
+                                                const std::string& prefix) {
+  out.feasible = out.failing_vertex_count == 0;
+  if (out.worst_vertex >= 0) out.worst_vertex_label = detail::VertexLabel(set, out.worst_vertex);
+  if (out.feasible) return out;
+
+  // Why not: the binding limits at the worst vertex.
+  if (options.explain) {
+    Result<std::vector<Shortfall>> shortfalls =
+        detail::FindShortfalls(explain_config, query, p_WO, set.vertex(out.worst_vertex), *lp);
+    if (!shortfalls) return std::unexpected(shortfalls.error());
+    out.shortfalls = std::move(*shortfalls);
+  }
+  std::string reason = prefix;
+  if (set.count == 1) {
+    reason += " (" + out.worst_vertex_label + "): ";
+  } else {
+    reason += ": vertex " + std::to_string(out.worst_vertex + 1) + "/" +
+              std::to_string(set.count) + " (" + out.worst_vertex_label + "): ";
+  }
+  if (out.shortfalls.empty()) {
+    reason += std::isinf(out.utilisation)
+                  ? std::string("no support can balance the load")
+                  : "the supports would need " + detail::FormatNumber(100.0 * out.utilisation) +
+                        "% of their limits";
+  } else {
+    reason += detail::DescribeShortfalls(explain_config, query, out.shortfalls,
+                                         kMaxShortfallsInReason);
+  }
+  if (out.failing_vertex_count > 1) {
+    reason += " (" + std::to_string(out.failing_vertex_count - 1) + " more of the " +
+              std::to_string(set.count) + " vertices fail)";
+  }
+  out.reason = std::move(reason);
+  return out;
+}
+
+Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config,
+                                                 const WrenchQuery& query) {
+  if (auto valid = detail::Validate(config, query); !valid) return std::unexpected(valid.error());
+  const WrenchGate gate = query.gate;
+  const bool grippers_on = detail::GrippersActive(gate);
+  const bool tables_on = detail::TablesActive(gate);
+  const int ng = static_cast<int>(config.grippers.size());
+  const int nc = static_cast<int>(config.connections.size());
+  const int nt = static_cast<int>(config.tables.size());
+
+  WrenchCheck out;
+  if (grippers_on) {
+    for (int g = 0; g < ng; ++g) out.supports.push_back({SupportKind::kGripper, g});
+  }
+  for (int c = 0; c < nc; ++c) out.supports.push_back({SupportKind::kConnection, c});
+  if (tables_on) {
+    for (int t = 0; t < nt; ++t) out.supports.push_back({SupportKind::kTable, t});
+  }
+  if (query.mode == MatingWrenchMode::kNone) return out;
+  if (gate == WrenchGate::kAssembly) {
+    for (const WrenchGripper& g : config.grippers) {
+      if (!(g.assembly_limits == g.transport_limits)) {
+        return ComputeHeldThenMated(config, query, std::move(out));
+      }
+    }
+  }
+
+  // Columns: every gripper and connection component that can carry load, every table generator.
+  const Vec3 p_WO = detail::ReferencePoint(config);
+  const int rows = static_cast<int>(config.bodies.size()) * 6;
+  BuildColumns(config, gate, p_WO, false);
+  const int n = static_cast<int>(columns.size());
 
   detail::BuildVertices(config, query, p_WO, vertices);
   out.vertex_count = vertices.count;
@@ -212,20 +307,7 @@ Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config
       if (s > 0.0) Accumulate(config, solution.x, 1.0 / s, v, out);
     } else if (status == LpStatus::kUnbounded) {
       // Unlimited supports carry everything: find such a balance for the table's friction use.
-      zero_problem = problem;
-      zero_problem.cost[n] = 0.0;
-      zero_problem.lower[n] = zero_problem.upper[n] = 1.0;
-      for (int j = 0; j < n; ++j) {
-        if (std::isfinite(zero_problem.lower[j])) zero_problem.lower[j] = 0.0;
-        if (std::isfinite(zero_problem.upper[j])) zero_problem.upper[j] = 0.0;
-      }
-      status = lp->Solve(zero_problem, solution);
-      if (status != LpStatus::kOptimal) {
-        return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
-                                              "' found the load factor unbounded but no " +
-                                              "balance at zero utilisation (" +
-                                              std::string(ToString(status)) + ")");
-      }
+      if (auto zero = SolveAtZeroUtilisation(n); !zero) return std::unexpected(zero.error());
       Accumulate(config, solution.x, 1.0, v, out);
     } else {
       return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
@@ -240,39 +322,190 @@ Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config
     }
   }
   out.utilisation = worst < 0.0 ? 0.0 : worst;
-  out.feasible = out.failing_vertex_count == 0;
-  if (out.worst_vertex >= 0)
-    out.worst_vertex_label = detail::VertexLabel(vertices, out.worst_vertex);
-  if (out.feasible) return out;
+  return Finish(config, query, p_WO, vertices, std::move(out), std::string(ToString(gate)));
+}
 
-  // Why not: the binding limits at the worst vertex.
-  if (options.explain) {
-    Result<std::vector<Shortfall>> shortfalls =
-        detail::FindShortfalls(config, query, p_WO, vertices.vertex(out.worst_vertex), *lp);
-    if (!shortfalls) return std::unexpected(shortfalls.error());
-    out.shortfalls = std::move(*shortfalls);
+Result<void> WrenchChecker::Impl::SolveAtZeroUtilisation(int n) {
+  zero_problem = problem;
+  zero_problem.cost[n] = 0.0;
+  zero_problem.lower[n] = zero_problem.upper[n] = 1.0;
+  for (int j = 0; j < n; ++j) {
+    if (std::isfinite(zero_problem.lower[j])) zero_problem.lower[j] = 0.0;
+    if (std::isfinite(zero_problem.upper[j])) zero_problem.upper[j] = 0.0;
   }
-  std::string reason(ToString(gate));
-  if (vertices.count == 1) {
-    reason += " (" + out.worst_vertex_label + "): ";
-  } else {
-    reason += ": vertex " + std::to_string(out.worst_vertex + 1) + "/" +
-              std::to_string(vertices.count) + " (" + out.worst_vertex_label + "): ";
+  const LpStatus status = lp->Solve(zero_problem, solution);
+  if (status != LpStatus::kOptimal) {
+    return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
+                                          "' found the load factor unbounded but no " +
+                                          "balance at zero utilisation (" +
+                                          std::string(ToString(status)) + ")");
   }
-  if (out.shortfalls.empty()) {
-    reason += std::isinf(out.utilisation)
-                  ? std::string("no support can balance the load")
-                  : "the supports would need " + detail::FormatNumber(100.0 * out.utilisation) +
-                        "% of their limits";
-  } else {
-    reason += detail::DescribeShortfalls(config, query, out.shortfalls, kMaxShortfallsInReason);
+  return {};
+}
+
+Result<WrenchCheck> WrenchChecker::Impl::ComputeHeldThenMated(const StepConfiguration& config,
+                                                              const WrenchQuery& query,
+                                                              WrenchCheck out) {
+  const Vec3 p_WO = detail::ReferencePoint(config);
+  const int nb6 = static_cast<int>(config.bodies.size()) * 6;
+  BuildColumns(config, WrenchGate::kAssembly, p_WO, true);  // Total bounds: transport boxes.
+  const int n = static_cast<int>(columns.size());
+  const double s_feasible = 1.0 - options.tolerance;
+
+  // Stage 1: the weight held before the parts touch (transport limits, tables as they are).
+  WrenchQuery hold_query = query;
+  hold_query.gate = WrenchGate::kRelease;
+  hold_query.mode = MatingWrenchMode::kGravityOnly;
+  detail::VertexSet hold_set;
+  detail::BuildVertices(config, hold_query, p_WO, hold_set);
+  const double* w_grav = hold_set.vertex(0);
+  double hold_utilisation = 0.0;
+  {
+    std::copy(w_grav, w_grav + nb6, problem.column(n));
+    lp->LoadBase(problem, n);
+    const LpStatus status = lp->SolveWithColumn(w_grav, solution);
+    if (status == LpStatus::kOptimal) {
+      const double s = solution.x[n] > kTinyLoadFactor ? solution.x[n] : 0.0;
+      hold_utilisation = s > 0.0 ? 1.0 / s : kInf;
+      if (s < s_feasible) {
+        out.vertex_count = 1;
+        out.failing_vertex_count = 1;
+        out.worst_vertex = 0;
+        out.utilisation = hold_utilisation;
+        if (s > 0.0) Accumulate(config, solution.x, 1.0 / s, 0, out);
+        return Finish(config, hold_query, p_WO, hold_set, std::move(out),
+                      "assembly, holding the parts before they touch");
+      }
+    } else if (status != LpStatus::kUnbounded) {
+      return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
+                                            "' returned " + std::string(ToString(status)) +
+                                            " on the holding LP");
+    }
   }
-  if (out.failing_vertex_count > 1) {
-    reason += " (" + std::to_string(out.failing_vertex_count - 1) + " more of the " +
-              std::to_string(vertices.count) + " vertices fail)";
+
+  // Stage 2, per vertex of the mating set without gravity: holding wrenches h balance gravity,
+  // totals t balance gravity plus s times the mating load, both within the total bounds, and a
+  // mode-dependent gripper's increment d = t - h within its assembly box.
+  std::vector<int> coupled;  // Columns of grippers whose assembly box differs.
+  for (int j = 0; j < n; ++j) {
+    const detail::ColumnInfo& c = columns[j];
+    if (c.kind != SupportKind::kGripper) continue;
+    const WrenchGripper& g = config.grippers[c.owner];
+    if (!(g.assembly_limits == g.transport_limits)) coupled.push_back(j);
   }
-  out.reason = std::move(reason);
-  return out;
+  const int nv = static_cast<int>(coupled.size());
+  const int rows = 2 * nb6 + nv;
+  const int s_col = 2 * n + nv;
+  LpProblem& joint = zero_problem;
+  joint.Reset(rows, s_col + 1);
+  for (int j = 0; j < n; ++j) {
+    const double* a = problem.column(j);
+    double* hj = joint.column(j);
+    double* tj = joint.column(n + j);
+    for (int i = 0; i < nb6; ++i) {
+      hj[i] = a[i];         // Gravity rows: A h = -w_grav.
+      hj[nb6 + i] = -a[i];  // Mating rows: A (t - h) + s w = 0.
+      tj[nb6 + i] = a[i];
+    }
+    joint.lower[j] = joint.lower[n + j] = lower[j];
+    joint.upper[j] = joint.upper[n + j] = upper[j];
+  }
+  for (int k = 0; k < nv; ++k) {
+    const int j = coupled[k];
+    const detail::ColumnInfo& c = columns[j];
+    const WrenchBounds& box = config.grippers[c.owner].assembly_limits;
+    joint.column(j)[2 * nb6 + k] = -1.0;
+    joint.column(n + j)[2 * nb6 + k] = 1.0;
+    joint.column(2 * n + k)[2 * nb6 + k] = -1.0;
+    joint.lower[2 * n + k] = box.lower[c.component];
+    joint.upper[2 * n + k] = box.upper[c.component];
+  }
+  for (int i = 0; i < nb6; ++i) joint.rhs[i] = -w_grav[i];
+  joint.cost[s_col] = -1.0;  // Maximise s.
+  joint.lower[s_col] = 0.0;
+  joint.upper[s_col] = kInf;
+
+  StepConfiguration mating_only = config;
+  mating_only.gravity_W = Vec3::Zero();
+  detail::BuildVertices(mating_only, query, p_WO, vertices);
+  out.vertex_count = vertices.count;
+  lp->LoadBase(joint, s_col);
+  std::vector<double> total(n), hold(n);
+  std::vector<double> worst_hold;
+  double worst = -1.0;
+  for (int v = 0; v < vertices.count; ++v) {
+    const double* w = vertices.vertex(v);
+    std::copy(w, w + nb6, joint.column(s_col) + nb6);
+    std::fill(joint.column(s_col), joint.column(s_col) + nb6, 0.0);
+    for (int k = 0; k < nv; ++k) joint.column(s_col)[2 * nb6 + k] = 0.0;
+    LpStatus status = lp->SolveWithColumn(joint.column(s_col), solution);
+    double s = kInf;
+    if (status == LpStatus::kOptimal) {
+      s = solution.x[s_col] > kTinyLoadFactor ? solution.x[s_col] : 0.0;
+    } else if (status == LpStatus::kUnbounded) {
+      // Unlimited supports carry the mating load: any balance at s = 1 for the reports.
+      LpProblem at_one = joint;
+      at_one.cost[s_col] = 0.0;
+      at_one.lower[s_col] = at_one.upper[s_col] = 1.0;
+      status = lp->Solve(at_one, solution);
+      if (status != LpStatus::kOptimal) {
+        return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
+                                              "' found the mating load factor unbounded but no " +
+                                              "balance at 1 (" + std::string(ToString(status)) +
+                                              ")");
+      }
+    } else {
+      return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
+                                            "' returned " + std::string(ToString(status)) +
+                                            " on the mating LP of vertex " + std::to_string(v));
+    }
+    const bool failing = s < s_feasible;
+    const double utilisation =
+        std::max(hold_utilisation, s > 0.0 ? (std::isinf(s) ? 0.0 : 1.0 / s) : kInf);
+    if (s > 0.0) {
+      // Loads at the unscaled mating wrench: h + (t - h) / s.
+      const double scale = std::isinf(s) ? 1.0 : 1.0 / s;
+      for (int j = 0; j < n; ++j) {
+        hold[j] = solution.x[j];
+        total[j] = hold[j] + (solution.x[n + j] - hold[j]) * scale;
+      }
+      Accumulate(config, total, 1.0, v, out);
+    } else {
+      for (int j = 0; j < n; ++j) hold[j] = solution.x[j];
+    }
+    if (failing) ++out.failing_vertex_count;
+    if (utilisation > worst) {
+      worst = utilisation;
+      out.worst_vertex = v;
+      worst_hold = hold;
+    }
+  }
+  out.utilisation = worst < 0.0 ? hold_utilisation : worst;
+  if (out.failing_vertex_count == 0) {
+    return Finish(config, query, p_WO, vertices, std::move(out), "assembly");
+  }
+  // The explanation: what the mating load needs beyond what the holding wrenches of the worst
+  // vertex leave (totals within limits, mode-dependent grippers within their assembly box).
+  StepConfiguration left = mating_only;
+  for (WrenchGripper& g : left.grippers) g.assembly_limits = WrenchBounds{};
+  for (WrenchConnection& c : left.connections) c.limits = WrenchBounds{};
+  for (int j = 0; j < n; ++j) {
+    const detail::ColumnInfo& c = columns[j];
+    if (c.kind == SupportKind::kTable) continue;
+    double lo = std::min(0.0, lower[j] - worst_hold[j]);
+    double hi = std::max(0.0, upper[j] - worst_hold[j]);
+    if (c.kind == SupportKind::kGripper) {
+      const WrenchBounds& box = config.grippers[c.owner].assembly_limits;
+      lo = std::min(0.0, std::max(lo, box.lower[c.component]));
+      hi = std::max(0.0, std::min(hi, box.upper[c.component]));
+      left.grippers[c.owner].assembly_limits.lower[c.component] = lo;
+      left.grippers[c.owner].assembly_limits.upper[c.component] = hi;
+    } else {
+      left.connections[c.owner].limits.lower[c.component] = lo;
+      left.connections[c.owner].limits.upper[c.component] = hi;
+    }
+  }
+  return Finish(left, query, p_WO, vertices, std::move(out), "assembly");
 }
 
 WrenchChecker::WrenchChecker(const WrenchOptions& options) : impl_(std::make_unique<Impl>()) {

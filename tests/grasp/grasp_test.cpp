@@ -210,6 +210,28 @@ TEST(Vacuum, OnlyOnFacesLargeEnoughForTheCup) {
   EXPECT_NE(none->warnings[0].find("no grasp"), std::string::npos);
 }
 
+// A cup centred on a face of a box sits on the line through its centre of mass: the grasp a
+// vacuum insertion needs (the paper's assembly box allows no moment). The sampler tries the
+// middle of every flat face first, so both large faces' centres are among the grasps.
+TEST(Vacuum, FaceCentresAreAmongTheGrasps) {
+  const Vec3 size(0.03, 0.06, 0.10);
+  const Scene s = OneBox(size, "vacuum_cup");
+  RunContext ctx(2);
+  auto r = Preprocess(s.project, s.check, Quick(), ctx);
+  ASSERT_TRUE(r) << r.error().message;
+  int centred = 0;
+  for (const Grasp& g : r->subassemblies.at(0).grasp_sets.at(0).grasps) {
+    const Vec3 p = g.X_PG.translation();
+    if (std::abs(p.y()) < 1e-9 && std::abs(p.z()) < 1e-9) {
+      ++centred;
+      // The cup axis passes through the box's centre (its centre of mass).
+      const Vec3 z_G = g.X_PG.linear().col(2);
+      EXPECT_LT(z_G.cross(-p).norm(), 1e-9);
+    }
+  }
+  EXPECT_EQ(centred, 2);
+}
+
 TEST(Grasps, SpreadOverTheSurface) {
   // A long bar: the grasps should cover much of its length, with no two in one spot.
   const Scene s = OneBox(Vec3(0.03, 0.03, 0.3), "robotiq_2f85");

@@ -92,8 +92,9 @@ TEST_P(ExamplePlan, IsSolvedAndValid) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Projects, ExamplePlan,
-                         ::testing::Values("stool", "half_stool", "chair", "cross",
-                                           "fabrica_plumbers_block", "fabrica_beam"),
+                         ::testing::Values("stool", "half_stool", "chair", "cross", "cube",
+                                           "cube_2x2x3", "fabrica_plumbers_block",
+                                           "fabrica_beam"),
                          [](const auto& param_info) { return param_info.param; });
 
 // The cross with 2 and 3 of its 4 robots (the paper's scaling in robots).

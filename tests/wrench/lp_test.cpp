@@ -312,7 +312,7 @@ TEST(WrenchBackends, DenseMatchesClpOnRandomConfigurations) {
   }
   EXPECT_GT(feasible, 500);
   EXPECT_GT(infeasible, 500);
-  EXPECT_GT(vertices, 10000);
+  EXPECT_GT(vertices, 8000);  // Held-then-mated checks that fail holding stop at 1 vertex.
   EXPECT_LT(close, 10);
 }
 

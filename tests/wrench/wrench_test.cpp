@@ -190,7 +190,7 @@ StepConfiguration VacuumFromSide() {
 }
 
 TEST(WrenchVacuum, TransportTakesTransverseForceAssemblyDoesNot) {
-  const StepConfiguration c = VacuumFromSide();
+  StepConfiguration c = VacuumFromSide();
   WrenchQuery transport;
   transport.gate = WrenchGate::kTransport;
   transport.accel_margin_mps2 = 0.0;
@@ -200,17 +200,42 @@ TEST(WrenchVacuum, TransportTakesTransverseForceAssemblyDoesNot) {
   EXPECT_NEAR(carried.utilisation, 0.5 * kG / 67.4, 1e-12);
   EXPECT_EQ(Load(carried, SupportKind::kGripper, 0).component, 0);
 
-  WrenchQuery assembly;
-  assembly.gate = WrenchGate::kAssembly;
-  assembly.mode = MatingWrenchMode::kGravityOnly;
-  const WrenchCheck mating = MustCheck(c, assembly);
-  EXPECT_FALSE(mating.feasible);
-  EXPECT_EQ(mating.reason,
-            "assembly (gravity): the vacuum gripper 'r1' on 'seat' would need 4.91 N along -x in "
+  // Assembly: the cup already holds the weight before the parts touch (as in transport); only
+  // what the insertion adds must lie in the assembly box (F_z alone).
+  WrenchQuery gravity;
+  gravity.gate = WrenchGate::kAssembly;
+  gravity.mode = MatingWrenchMode::kGravityOnly;
+  const WrenchCheck held = MustCheck(c, gravity);
+  EXPECT_TRUE(held.feasible) << held.reason;
+  EXPECT_NEAR(held.utilisation, 0.5 * kG / 67.4, 1e-9);
+
+  // A post held by a two-finger gripper below the seat; the seat is pressed down onto it.
+  c.bodies.push_back({"post", 0.2, Vec3(0.3, 0.2, 0.9)});
+  c.grippers.push_back(
+      MakeGripper("r2", 1, At(Vec3(0.3, 0.2, 0.9)), EndEffectorKind::kTwoFinger, WrenchLimits{}));
+  MatingLoad m;
+  m.moved = 0;
+  m.base = 1;
+  m.axis_W = -Vec3::UnitZ();  // Across the cup's axis: the cup would have to push sideways.
+  m.p_WContact = Vec3(0.3, 0.2, 0.95);
+  m.force_N = 10.0;
+  c.mating = m;
+  const WrenchCheck across = MustCheck(c);
+  EXPECT_FALSE(across.feasible);
+  EXPECT_EQ(across.reason,
+            "assembly (nominal): the vacuum gripper 'r1' on 'seat' would need 10 N along x in "
             "assembly mode (limit 0)");
-  ASSERT_FALSE(mating.shortfalls.empty());
-  EXPECT_EQ(mating.shortfalls[0].kind, ShortfallKind::kGripperLimit);
-  EXPECT_NEAR(mating.shortfalls[0].needed, -0.5 * kG, 1e-9);
+  ASSERT_FALSE(across.shortfalls.empty());
+  EXPECT_EQ(across.shortfalls[0].kind, ShortfallKind::kGripperLimit);
+  EXPECT_NEAR(across.shortfalls[0].needed, 10.0, 1e-9);  // x_G = -z_W
+
+  // Along the cup's axis (+x_W = z_G) the push is allowed: 10 N of its 110 N, beside the weight
+  // held along x_G (4.9 N of 67.4 N).
+  c.mating->axis_W = Vec3::UnitX();
+  c.mating->p_WContact = Vec3(0.35, 0.2, 1.0);  // On the cup's axis: no moment.
+  const WrenchCheck along = MustCheck(c);
+  EXPECT_TRUE(along.feasible) << along.reason;
+  EXPECT_NEAR(Load(along, SupportKind::kGripper, 0).utilisation, 10.0 / 110.0, 1e-9);
 }
 
 TEST(WrenchVacuum, TransportWithAccelerationMargin) {

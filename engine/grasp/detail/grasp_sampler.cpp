@@ -21,6 +21,53 @@ Vec3 Tilted(const Vec3& axis, double angle, double phase) {
   return std::cos(angle) * axis + std::sin(angle) * (std::cos(phase) * u + std::sin(phase) * v);
 }
 
+// One planar patch of a mesh: triangles sharing a plane (normals within ~1 degree, offsets
+// within `tol`), its area-weighted centroid and area.
+struct PlanarPatch {
+  Vec3 centroid = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();
+  double area = 0.0;
+};
+
+// The planar patches of at least `min_area`, largest first. Where an engineer would put a cup:
+// at the middle of a flat face (on a symmetric part, on the line through its centre of mass).
+std::vector<PlanarPatch> PlanarPatches(const MeshRaycaster& part, double tol, double min_area) {
+  const TriangleMesh& mesh = part.mesh();
+  std::vector<PlanarPatch> patches;
+  std::vector<double> offsets;
+  for (int t = 0; t < static_cast<int>(mesh.triangles.size()); ++t) {
+    const Vec3& n = part.normal(t);
+    if (n.squaredNorm() < 0.5) continue;  // Degenerate.
+    const Eigen::Vector3i& tri = mesh.triangles[t];
+    const Vec3& a = mesh.vertices[tri[0]];
+    const Vec3& b = mesh.vertices[tri[1]];
+    const Vec3& c = mesh.vertices[tri[2]];
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    const double offset = n.dot(a);
+    int found = -1;
+    for (int k = 0; k < static_cast<int>(patches.size()) && found < 0; ++k) {
+      if (patches[k].normal.dot(n) > 0.99985 && std::abs(offsets[k] - offset) <= tol) found = k;
+    }
+    if (found < 0) {
+      patches.push_back({Vec3::Zero(), n, 0.0});
+      offsets.push_back(offset);
+      found = static_cast<int>(patches.size()) - 1;
+    }
+    PlanarPatch& p = patches[found];
+    p.centroid += area * (a + b + c) / 3.0;
+    p.area += area;
+  }
+  std::vector<PlanarPatch> out;
+  for (PlanarPatch& p : patches) {
+    if (p.area < min_area || p.area <= 0.0) continue;
+    p.centroid /= p.area;
+    out.push_back(p);
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const PlanarPatch& a, const PlanarPatch& b) { return a.area > b.area; });
+  return out;
+}
+
 double AngleBetween(const Vec3& a, const Vec3& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b));
 }
@@ -199,12 +246,25 @@ std::vector<GraspCandidate> SampleVacuum(const SamplerInput& in, const VacuumGra
   const Vec3 a_T = (R_TF * Vec3::UnitZ()).normalized();
   const Vec3 x_T = a_T.unitOrthogonal();
 
-  for (int sample = 0; sample < in.max_samples && static_cast<int>(out.size()) < in.wanted;
+  // First the middle of every flat face the cup fits on (a cup centred on a symmetric part's
+  // face lies on the line through its centre of mass: no moment while mating, where the paper's
+  // assembly box allows none), then points drawn uniformly over the surface.
+  const std::vector<PlanarPatch> patches =
+      PlanarPatches(part, tol, std::numbers::pi * radius * radius);
+  const int n_patches = static_cast<int>(patches.size());
+  for (int sample = 0;
+       sample < in.max_samples + n_patches && static_cast<int>(out.size()) < in.wanted;
        ++sample) {
     if (sample % kStopCheckEvery == 0 && ctx.ShouldStop()) break;
-    int tri = -1;
-    const Vec3 p = part.SamplePoint(rng, &tri);
-    const Vec3 n = part.normal(tri);
+    Vec3 p, n;
+    if (sample < n_patches) {
+      p = patches[sample].centroid;
+      n = patches[sample].normal;
+    } else {
+      int tri = -1;
+      p = part.SamplePoint(rng, &tri);
+      n = part.normal(tri);
+    }
     const Vec3 u = Tilted(n, 0.5 * std::numbers::pi, 2.0 * std::numbers::pi * Uniform01(rng));
     const Vec3 v = n.cross(u);
     // Disc test points: the centre, a ring at r/2 and the rim.
