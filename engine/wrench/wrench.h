@@ -128,7 +128,10 @@ struct StepConfiguration {
 
 /// Which gate of the search asks: decides the external wrenches, the vacuum box and the supports.
 enum class WrenchGate {
-  kAssembly,   ///< Mating under way: gravity + the mating wrench set U; assembly limits.
+  kAssembly,   ///< Mating under way: gravity + the mating wrench set U; assembly limits. With
+               ///< a gripper whose assembly box differs from its transport box (vacuum), in two
+               ///< stages: the weight held within the transport limits, then what the mating
+               ///< adds within the assembly box (wrench.cpp, "held, then mated").
   kTransport,  ///< Carried: gravity and every acceleration with components in +-margin; transport
                ///< limits; table supports are ignored (the bodies are in the air).
   kRelease,    ///< Holding still after a release: gravity only; transport limits; the caller
