@@ -89,6 +89,12 @@ struct WrenchChecker::Impl {
   // The variant of `problem` with s = 1 and every finite bound at 0 (the load factor was
   // unbounded: unlimited supports carry the load); its solution into `solution`.
   Result<void> SolveAtZeroUtilisation(int n);
+  // The internal error of an LP that ended with `status` instead of an answer.
+  std::unexpected<Error> LpFailed(LpStatus status, const std::string& which) const {
+    return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
+                                          "' returned " + std::string(ToString(status)) +
+                                          " on " + which);
+  }
   // The "held, then mated" assembly check (see the top of this file); `out` has its supports.
   Result<WrenchCheck> ComputeHeldThenMated(const StepConfiguration& config,
                                            const WrenchQuery& query, WrenchCheck out);
@@ -310,10 +316,7 @@ Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config
       if (auto zero = SolveAtZeroUtilisation(n); !zero) return std::unexpected(zero.error());
       Accumulate(config, solution.x, 1.0, v, out);
     } else {
-      return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
-                                            "' returned " + std::string(ToString(status)) +
-                                            " on the load-factor LP of vertex " +
-                                            std::to_string(v));
+      return LpFailed(status, "the load-factor LP of vertex " + std::to_string(v));
     }
     if (failing) ++out.failing_vertex_count;
     if (utilisation > worst) {
@@ -377,9 +380,7 @@ Result<WrenchCheck> WrenchChecker::Impl::ComputeHeldThenMated(const StepConfigur
                       "assembly, holding the parts before they touch");
       }
     } else if (status != LpStatus::kUnbounded) {
-      return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
-                                            "' returned " + std::string(ToString(status)) +
-                                            " on the holding LP");
+      return LpFailed(status, "the holding LP");
     }
   }
 
@@ -455,9 +456,7 @@ Result<WrenchCheck> WrenchChecker::Impl::ComputeHeldThenMated(const StepConfigur
                                               ")");
       }
     } else {
-      return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
-                                            "' returned " + std::string(ToString(status)) +
-                                            " on the mating LP of vertex " + std::to_string(v));
+      return LpFailed(status, "the mating LP of vertex " + std::to_string(v));
     }
     const bool failing = s < s_feasible;
     const double utilisation =
