@@ -26,6 +26,9 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       "validate", "Check a project file: every problem with file, JSON path and reason");
   validate->add_option("PROJECT", project, "Project file (.json)")->required();
   validate->add_flag("-q,--quiet", quiet, "Print errors only, not warnings or the summary");
+  std::string validate_plan;
+  validate->add_option("--plan", validate_plan,
+                       "Also replay this plan (JSON) with the independent plan validator");
 
   CLI::App* info = app.add_subcommand(
       "info", "Describe a project: parts, the assembly DAG, robots and end effectors");
@@ -104,7 +107,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     const int code = app.exit(e, out, err);
     return code == 0 ? 0 : 2;
   }
-  if (validate->parsed()) return Validate(project, quiet, out, err);
+  if (validate->parsed()) return Validate(project, validate_plan, quiet, out, err);
   if (info->parsed()) return Info(project, out, err);
   if (preprocess->parsed()) {
     if (seed_option->count() > 0) pre.seed = seed;

@@ -7,14 +7,30 @@
 #include <string>
 #include <vector>
 
+namespace wrap {
+struct LoadedProject;
+struct Plan;
+}  // namespace wrap
+
 namespace wrap::cli {
 
 /// Runs `wrap` with `args` (without the program name), printing to `out` and `err`. Returns the
 /// process exit code: 0 success, 1 no plan / verification failed, 2 bad input, 3 internal error.
 int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
-/// `wrap validate PROJECT`: every problem, one per line; exit 0 valid (warnings allowed), 2 not.
-int Validate(const std::string& project, bool quiet, std::ostream& out, std::ostream& err);
+/// `wrap validate PROJECT [--plan PLAN.json]`: every problem of the project, one per line; with a
+/// plan, also replays it with the independent plan validator (its wrench mode and lambda from the
+/// plan's stats) and lists every issue. Exit 0 valid (warnings allowed), 1 the plan is not valid,
+/// 2 the project or the plan file is bad input or they do not match.
+int Validate(const std::string& project, const std::string& plan, bool quiet, std::ostream& out,
+             std::ostream& err);
+
+/// Replays `plan` of the loaded project with the independent validator and prints the verdict:
+/// the issues to `err`, or a one-line summary to `out`. Returns the exit code (0 valid, 1 not,
+/// 2 or 3 when the plan cannot be interpreted).
+
+int ReportPlanValidation(const LoadedProject& loaded, const Plan& plan,
+                         const std::string& project, std::ostream& out, std::ostream& err);
 
 /// `wrap info PROJECT`: parts with mass and size, the DAG as a tree, robots and end effectors.
 int Info(const std::string& project, std::ostream& out, std::ostream& err);

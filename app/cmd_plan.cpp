@@ -11,6 +11,31 @@
 
 namespace wrap::cli {
 
+int ReportPlanValidation(const LoadedProject& loaded, const Plan& plan,
+                         const std::string& project, std::ostream& out, std::ostream& err) {
+  PlanValidationOptions vopt;
+  if (plan.stats.wrench_mode == "gravity") {
+    vopt.wrench_mode = MatingWrenchMode::kGravityOnly;
+  } else if (plan.stats.wrench_mode == "none") {
+    vopt.wrench_mode = MatingWrenchMode::kNone;
+  }
+  vopt.force_scale = plan.stats.force_scale;
+  auto v = ValidatePlan(*loaded.project, loaded.check, plan, vopt, project);
+  if (!v) {
+    err << "validation: " << v.error().message << "\n";
+    return ExitCodeFor(v.error().code);
+  }
+  if (!v->valid) {
+    err << "Validation FAILED: " << v->issues.size() << " issue(s)\n";
+    for (const PlanIssue& issue : v->issues) err << "  " << FormatIssue(issue) << "\n";
+    return 1;
+  }
+  out << "Validated: " << v->actions << " actions, " << v->keyframes << " keyframes, "
+      << v->collision_checks << " collision queries, " << v->wrench_checks
+      << " wrench gates re-solved\n";
+  return 0;
+}
+
 int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   TaskPlannerOptions options;
   options.project_file = args.project;
@@ -91,24 +116,7 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   }
   if (!st.solved) return 1;
 
-  if (args.validate) {
-    PlanValidationOptions vopt;
-    vopt.wrench_mode = options.wrench_mode;
-    vopt.force_scale = options.force_scale;
-    auto v = ValidatePlan(p, loaded.check, *plan, vopt, args.project);
-    if (!v) {
-      err << "validation: " << v.error().message << "\n";
-      return ExitCodeFor(v.error().code);
-    }
-    if (!v->valid) {
-      err << "Validation FAILED: " << v->issues.size() << " issue(s)\n";
-      for (const PlanIssue& issue : v->issues) err << "  " << FormatIssue(issue) << "\n";
-      return 1;
-    }
-    out << "Validated: " << v->actions << " actions, " << v->keyframes << " keyframes, "
-        << v->collision_checks << " collision queries, " << v->wrench_checks
-        << " wrench gates re-solved\n";
-  }
+  if (args.validate) return ReportPlanValidation(loaded, *plan, args.project, out, err);
   return 0;
 }
 

@@ -1,7 +1,9 @@
+#include <optional>
 #include <ostream>
 
 #include "cli.h"
 #include "load.h"
+#include "task/plan_json.h"
 
 namespace wrap::cli {
 
@@ -16,7 +18,18 @@ void PrintDiagnostics(const Diagnostics& diags, bool errors_only, std::ostream& 
 
 }  // namespace
 
-int Validate(const std::string& project, bool quiet, std::ostream& out, std::ostream& err) {
+int Validate(const std::string& project, const std::string& plan_file, bool quiet,
+             std::ostream& out, std::ostream& err) {
+  // The plan's own structure is checked before the project (and its meshes) is loaded.
+  std::optional<Plan> plan;
+  if (!plan_file.empty()) {
+    auto read = ReadPlanFile(plan_file);
+    if (!read) {
+      err << read.error().message << "\n";
+      return 2;
+    }
+    plan = std::move(*read);
+  }
   const LoadedProject loaded = LoadChecked(project);
   const Diagnostics& diags = loaded.check.diagnostics;
   PrintDiagnostics(diags, quiet, err);
@@ -32,7 +45,17 @@ int Validate(const std::string& project, bool quiet, std::ostream& out, std::ost
     out << project << ": valid: " << p.parts.size() << " parts, " << p.steps.size() << " steps, "
         << p.robots.size() << " robots, " << diags.warning_count() << " warning(s)\n";
   }
-  return 0;
+  if (!plan) return 0;
+  if (!loaded.check.tree) {
+    err << project << ": the project has no assembly DAG to replay a plan against\n";
+    return 2;
+  }
+  if (auto ok = CheckPlanMatchesProject(*plan, *loaded.project, *loaded.check.tree, plan_file);
+      !ok) {
+    err << ok.error().message << "\n";
+    return 2;
+  }
+  return ReportPlanValidation(loaded, *plan, project, out, err);
 }
 
 }  // namespace wrap::cli

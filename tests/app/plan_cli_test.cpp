@@ -74,6 +74,39 @@ TEST(PlanCli, UnwritableOutputLeavesNothingAndExitsTwo) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// `wrap validate PROJECT --plan PLAN`: a planned plan replays valid (exit 0); the same plan with
+// one robot's joints moved at one keyframe is not (exit 1, naming the action); a plan of another
+// project and a file that is no plan are bad input (exit 2).
+TEST(PlanCli, ValidateReplaysAPlanFile) {
+  const fs::path dir = TempDir("validate_plan");
+  const fs::path good = dir / "plan.json";
+  ASSERT_EQ(Wrap({"plan", Project("half_stool"), "-o", good.string()}).code, 0);
+  const CliRun ok = Wrap({"validate", Project("half_stool"), "--plan", good.string()});
+  EXPECT_EQ(ok.code, 0) << ok.out << ok.err;
+  EXPECT_NE(ok.out.find("Validated:"), std::string::npos) << ok.out;
+
+  std::ifstream in(good);
+  nlohmann::ordered_json plan = nlohmann::ordered_json::parse(in);
+  // The first action's acting robot turns its first joint by 0.5 rad: its TCP leaves the grasp.
+  nlohmann::ordered_json& a0 = plan["actions"][0];
+  const std::string robot = a0["robots"][0];
+  a0["keyframe"]["q"][robot][0] = a0["keyframe"]["q"][robot][0].get<double>() + 0.5;
+  const fs::path bad = dir / "moved.json";
+  std::ofstream(bad) << plan.dump(2);
+  const CliRun moved = Wrap({"validate", Project("half_stool"), "--plan", bad.string()});
+  EXPECT_EQ(moved.code, 1) << moved.out << moved.err;
+  EXPECT_NE(moved.err.find("Validation FAILED"), std::string::npos) << moved.err;
+  EXPECT_NE(moved.err.find("action 0"), std::string::npos) << moved.err;
+
+  const CliRun other = Wrap({"validate", Project("cross"), "--plan", good.string()});
+  EXPECT_EQ(other.code, 2) << other.out << other.err;
+  const fs::path junk = dir / "junk.json";
+  std::ofstream(junk) << "{\"format\": \"wrap-plan\", \"actions\": 3}";
+  const CliRun garbage = Wrap({"validate", Project("half_stool"), "--plan", junk.string()});
+  EXPECT_EQ(garbage.code, 2) << garbage.out << garbage.err;
+  EXPECT_NE(garbage.err.find("junk.json"), std::string::npos) << garbage.err;
+}
+
 // Only vacuum cups and a step that needs transverse force: exit 1 naming the step.
 TEST(PlanCli, InfeasibleProjectExitsOneNamingTheStep) {
   const fs::path dir = TempDir("infeasible");
