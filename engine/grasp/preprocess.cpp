@@ -6,6 +6,7 @@
 #include <exception>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <random>
 
 #include "grasp/detail/grasp_sampler.h"
@@ -41,6 +42,29 @@ double AngleBetween(const Vec3& a, const Vec3& b) {
 
 bool SameMesh(const TriangleMesh& a, const TriangleMesh& b) {
   return a.vertices == b.vertices && a.triangles == b.triangles;
+}
+
+// Placements (most stable first) in which a grasp that clears the table counts as pickable.
+constexpr int kPickPlacements = 3;
+
+// A vacuum grasp of a moved input is an assembly grasp only when the cup pushes within this
+// angle's cosine (15 degrees) of the insertion direction.
+constexpr double kVacuumPushCos = 0.966;
+
+// A box of half extents h centred at c, triangles counter-clockwise seen from outside.
+TriangleMesh BoxMesh(const Vec3& c, const Vec3& h) {
+  TriangleMesh m;
+  for (int i = 0; i < 8; ++i) {
+    m.vertices.push_back(c + Vec3((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
+                                  (i & 4) ? h.z() : -h.z()));
+  }
+  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) {
+    m.triangles.emplace_back(f[0], f[1], f[2]);
+    m.triangles.emplace_back(f[0], f[2], f[3]);
+  }
+  return m;
 }
 
 // Distance of point c from the line through x along unit u [m].
@@ -228,6 +252,12 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
     meshes.push_back(&check.parts[p].mesh);
     X_AP.push_back(ToIsometry(project.parts[p].assembled_pose));
   }
+  // The table as one more body: its top is the plane z = 0 of this frame, wide enough for any
+  // part (grasps are tested against it in the rest frame of a placement).
+  const TriangleMesh table_box = BoxMesh(Vec3(0.0, 0.0, -0.05), Vec3(5.0, 5.0, 0.05));
+  const int table_body = num_parts;
+  meshes.push_back(&table_box);
+  X_AP.push_back(Iso3::Identity());
   // The collision world (FCL's trees, built serially) alongside the parts' raycasters.
   Result<detail::GripperCollision> world = Fail(ErrorCode::kInternal, "not built");
   std::vector<std::unique_ptr<detail::MeshRaycaster>> rays(num_parts);
@@ -274,7 +304,50 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
   }
   lap("grasp_candidates");
 
+  // Rest frames in which grasps must clear the table: a part's initial pose (as a rest frame:
+  // rotation kept, lowest hull point at z = 0), and each subassembly's most stable placements.
+  std::vector<std::vector<Iso3>> rest_frames(num_subs);
+  for (int s = 0; s < num_subs; ++s) {
+    const Subassembly& sub = out.subassemblies[s];
+    if (sub.parts.size() == 1) {
+      const int p = sub.parts[0];
+      Iso3 X = ToIsometry(project.parts[p].initial_pose) * X_AP[p].inverse();
+      double low = std::numeric_limits<double>::infinity();
+      for (const Vec3& v : sub.hull.mesh.vertices) low = std::min(low, (X * v).z());
+      X.translation().z() -= low;
+      rest_frames[s].push_back(X);
+    }
+    for (int k = 0; k < std::min<int>(kPickPlacements, sub.placements.size()); ++k) {
+      rest_frames[s].push_back(sub.placements[k].X_TA);
+    }
+  }
+
+  // The partner of each subassembly at its mating: the parts of the other input of the step
+  // that consumes it (none for the root).
+  // A moved input also has its insertion direction: a vacuum cup inserts it only when it pushes
+  // along that direction (its assembly box allows force along the cup axis alone).
+  std::vector<std::vector<int>> partner(num_subs);
+  std::vector<std::optional<Vec3>> insertion(num_subs);
+  if (check.tree) {
+    for (const AssemblyNode& n : check.tree->nodes) {
+      if (n.inputs.size() != 2 || n.step < 0) continue;
+      partner[n.inputs[0]] = out.subassemblies[n.inputs[1]].parts;
+      partner[n.inputs[1]] = out.subassemblies[n.inputs[0]].parts;
+      const Mating& mating = project.steps[n.step].mating;
+      for (int input : n.inputs) {
+        if (check.tree->nodes[input].name == mating.moved && mating.axis.norm() > 0.0) {
+          insertion[input] = mating.axis.normalized();
+        }
+      }
+    }
+  }
+
   // Per subassembly and end effector: drop candidates that hit another part, score, spread.
+  // Half of each set (every other grasp, from the first) are assembly grasps: the gripper clears
+  // the partner input at the mating pose, so the inserting and the holding robot have grasps
+  // that work there whatever else the random candidates favour. Within each half, grasps that
+  // can take the subassembly from the table come first: the gripper clears the table top where
+  // the subassembly rests in its initial pose (a part) or one of its most stable placements.
   for (Subassembly& sub : out.subassemblies) sub.grasp_sets.resize(num_ee);
   detail::ParallelFor(num_subs * num_ee, options.parallel, [&](int task) {
     const int s = task / num_ee, e = task % num_ee;
@@ -286,6 +359,7 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
     std::vector<const GraspCandidate*> kept;
     std::vector<Vec3> x, a;
     std::vector<double> quality;
+    std::vector<char> clear_of_partner, pickable_at_rest;
     int checked = 0;
     for (size_t k = 0; k < sub.parts.size(); ++k) {
       const int p = sub.parts[k];
@@ -293,19 +367,36 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
       for (int o : sub.parts) {
         if (o != p) others.push_back(o);
       }
-      local.EnableOnly(others);
       const Iso3& X_AP_k = sub.X_AP[k];
       for (const GraspCandidate& c : candidates[p * num_ee + e]) {
         if (++checked % 32 == 0 && ctx.ShouldStop()) return;
+        Iso3 X_AT = X_AP_k * c.grasp.X_PG;
+        double opening = 0.0;
+        if (ee.kind == EndEffectorKind::kVacuum) {
+          X_AT.translation() -= options.vacuum.standoff_m * (X_AP_k.linear() * c.approach_P);
+        } else {
+          opening = c.grasp.width_m + 2.0 * options.two_finger.clearance_m;
+        }
         if (!others.empty()) {
-          Iso3 X_AT = X_AP_k * c.grasp.X_PG;
-          double opening = 0.0;
-          if (ee.kind == EndEffectorKind::kVacuum) {
-            X_AT.translation() -= options.vacuum.standoff_m * (X_AP_k.linear() * c.approach_P);
-          } else {
-            opening = c.grasp.width_m + 2.0 * options.two_finger.clearance_m;
-          }
+          local.EnableOnly(others);
           if (local.Collides(e, X_AT, opening)) continue;
+        }
+        bool clear = true;
+        if (!partner[s].empty()) {
+          local.EnableOnly(partner[s]);
+          clear = !local.Collides(e, X_AT, opening);
+        }
+        if (clear && ee.kind == EndEffectorKind::kVacuum && insertion[s]) {
+          clear = (X_AP_k.linear() * c.approach_P).dot(*insertion[s]) >= kVacuumPushCos;
+        }
+        bool pickable = false;
+        const int only_table[1] = {table_body};
+        local.EnableOnly(only_table);
+        for (const Iso3& X_TA : rest_frames[s]) {
+          if (!local.Collides(e, X_TA * X_AT, opening)) {
+            pickable = true;
+            break;
+          }
         }
         const Vec3 x_A = X_AP_k * c.center_P;
         const Vec3 axis_A = X_AP_k.linear() * c.axis_P;
@@ -313,19 +404,65 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
         kept.push_back(&c);
         x.push_back(x_A);
         a.push_back(X_AP_k.linear() * c.approach_P);
+        clear_of_partner.push_back(clear ? 1 : 0);
+        pickable_at_rest.push_back(pickable ? 1 : 0);
         quality.push_back(ee.kind == EndEffectorKind::kVacuum
                               ? (c.slack + com_term) / 2.0
                               : (c.slack + c.pad_fraction + com_term) / 3.0);
       }
     }
+    // Spread picks among a subset of the candidates, as indices into `kept`.
+    auto spread = [&](const std::vector<int>& among, int n) {
+      std::vector<Vec3> xs, as;
+      std::vector<double> qs;
+      for (int i : among) {
+        xs.push_back(x[i]);
+        as.push_back(a[i]);
+        qs.push_back(quality[i]);
+      }
+      std::vector<int> picked;
+      for (int j : FarthestPointOrder(xs, as, qs, n, 0.1 * diag, ctx)) picked.push_back(among[j]);
+      return picked;
+    };
+    // Tiers: assembly and pick, assembly only, pick only, neither.
+    std::vector<int> tier[4];
+    for (int i = 0; i < static_cast<int>(kept.size()); ++i) {
+      tier[(clear_of_partner[i] ? 0 : 2) + (pickable_at_rest[i] ? 0 : 1)].push_back(i);
+    }
+    const int n = out.grasps_per_set;
+    auto take = [&](std::vector<int>& list, int from_tier, int quota) {
+      const int want = quota - static_cast<int>(list.size());
+      if (want <= 0) return;
+      for (int i : spread(tier[from_tier], want)) list.push_back(i);
+    };
+    std::vector<int> first, second;
+    take(first, 0, (n + 1) / 2);
+    take(first, 1, (n + 1) / 2);
+    take(second, 2, n - static_cast<int>(first.size()));
+    take(second, 3, n - static_cast<int>(first.size()));
+    // Too few assembly grasps: the other half takes up the slack from what is left.
+    if (static_cast<int>(first.size() + second.size()) < n) {
+      std::vector<int> left;
+      for (int t : {0, 1}) {
+        for (int i : tier[t]) {
+          if (std::find(first.begin(), first.end(), i) == first.end()) left.push_back(i);
+        }
+      }
+      tier[0] = left;
+      take(second, 0, n - static_cast<int>(first.size()));
+    }
     GraspSet set;
     set.end_effector = ee.name;
     set.kind = ee.kind;
     set.candidates = static_cast<int>(kept.size());
-    for (int i : FarthestPointOrder(x, a, quality, out.grasps_per_set, 0.1 * diag, ctx)) {
-      Grasp g = kept[i]->grasp;
-      g.quality = quality[i];
-      set.grasps.push_back(std::move(g));
+    for (size_t k = 0; k < std::max(first.size(), second.size()); ++k) {
+      for (const std::vector<int>* list : {&first, &second}) {
+        if (k >= list->size()) continue;
+        const int i = (*list)[k];
+        Grasp g = kept[i]->grasp;
+        g.quality = quality[i];
+        set.grasps.push_back(std::move(g));
+      }
     }
     sub.grasp_sets[e] = std::move(set);
   });

@@ -82,7 +82,8 @@ TaskSearch::TaskSearch(const TaskWorld& world, TaskTables& tables, KeyframeSolve
       ctx_(ctx),
       seed_(seed),
       widen_(widen),
-      n_robots_(static_cast<int>(world.robots.size())) {}
+      n_robots_(static_cast<int>(world.robots.size())),
+      use_backward_(options.planner == "wrap") {}
 
 TaskSearch::Resolution TaskSearch::ResolutionAt(int level) const {
   constexpr int kGrasps[] = {6, 12, 1 << 20};
@@ -126,9 +127,20 @@ bool TaskSearch::GraspsApart(int grasp_a, int grasp_b) const {
   return X_AGa.linear().col(2).dot(X_AGb.linear().col(2)) < limit;
 }
 
-int TaskSearch::Heuristic(const SymState& s, const Milestone& m) const {
+int TaskSearch::Heuristic(const SymState& s, const Milestone& m) {
   int h = 0;
   const bool done = s.loc[m.step] != kInactive;
+  if (use_backward_ && !done) {
+    // WRAP: the abstract distance to the assembly, the releases of other objects, and the
+    // release of the product when no later step takes it from the hands that hold it.
+    h = BackwardDistance(s);
+    for (int r = 0; r < n_robots_; ++r) {
+      const int o = s.held[r];
+      if (o >= 0 && o != m.moved && o != m.base && o != m.keep[0] && o != m.keep[1]) h += 1;
+    }
+    if (m.final || (m.step != m.keep[0] && m.step != m.keep[1])) h += 1;
+    return h;
+  }
   bool m_needs_grasp = false;
   if (!done) {
     h += 1;
@@ -686,6 +698,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   }
   const int levels = 3;
   std::vector<int> path;
+  std::string abstract_failure;  // why the backward abstraction found no way, at the last level
   // The committed prefix: validated states from s0 on. The search starts from its last state;
   // a candidate plan's validated edges are committed (greedy, like the paper's lazy greedy fill);
   // when the search from a committed state finds nothing, that state is abandoned (its entering
@@ -697,6 +710,21 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   };
   for (int level = 0; level < levels; ++level) {
     const Resolution res = ResolutionAt(level);
+    if (use_backward_) {
+      const auto t0 = Clock::now();
+      BuildBackward(m, res, s0);
+      bwd_s_ += std::chrono::duration<double>(Clock::now() - t0).count();
+      if (std::getenv("WRAP_TASK_DEBUG")) {
+        std::fprintf(stderr, "[task] milestone %d level %d: backward distance %d at the start\n",
+                     index, level, BackwardDistance(s0));
+      }
+      if (!backward_.why.empty()) {
+        // The relaxation cannot reach the assembly: neither can the search at this resolution.
+        abstract_failure = backward_.why;
+        if (level + 1 < levels) ++widenings_;
+        continue;
+      }
+    }
     for (int effort = 0; effort <= options_.max_effort; ++effort) {
       bool suspended_below = false;  // an edge that failed at this effort could be retried
       std::vector<Committed> prefix{{s0, c0, 0}};
@@ -799,7 +827,8 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   result.failure = "milestone " + std::to_string(index + 1) + " '" + world_.tree->nodes[step].name +
                    "' (moving '" + world_.tree->nodes[st.moved].name + "' onto '" +
                    world_.tree->nodes[st.base].name +
-                   "'): no plan with every grasp, placement and effort level; " + tally_.Summary();
+                   "'): no plan with every grasp, placement and effort level; " +
+                   (abstract_failure.empty() ? tally_.Summary() : abstract_failure);
   return result;
 }
 

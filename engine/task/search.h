@@ -45,6 +45,9 @@ struct MilestoneResult {
 /// The lazy search of the task planner.
 class TaskSearch {
  public:
+  /// Backward distance of a state from which the abstraction cannot reach the assembly.
+  static constexpr int kFarDistance = 1000;
+
   TaskSearch(const TaskWorld& world, TaskTables& tables, KeyframeSolver& solver,
              const TaskPlannerOptions& options, RunContext& ctx, std::uint64_t seed, bool widen);
 
@@ -57,6 +60,7 @@ class TaskSearch {
   long long expansions() const { return expansions_; }
   int widenings() const { return widenings_; }
   double search_seconds() const { return search_s_; }
+  double backward_seconds() const { return bwd_s_; }
 
  private:
   struct Resolution {
@@ -82,7 +86,14 @@ class TaskSearch {
 
   Resolution ResolutionAt(int level) const;
   const std::vector<int>& GraspIds(int node, int robot);
-  int Heuristic(const SymState& s, const Milestone& m) const;
+  int Heuristic(const SymState& s, const Milestone& m);
+  /// WRAP's backward abstract heuristic (backward.cpp): the abstract graph of milestone `m` at
+  /// resolution `res` from the start state s0, and its distance of a forward state.
+  void BuildBackward(const Milestone& m, const Resolution& res, const SymState& s0);
+  int BackwardDistance(const SymState& s);
+  /// Whether grasp id `grasp` of input 0 (moved) or 1 (base) of the current milestone is an
+  /// assembly grasp: the gripper clears the other input at the mating pose. Cached.
+  bool AssemblyGrasp(int input, int robot, int grasp);
   bool IsGoal(const SymState& s, const Milestone& m, const std::set<std::uint64_t>& excluded) const;
   void Successors(const SymState& s, const Milestone& m, const Resolution& res,
                   std::vector<std::pair<TaskAction, SymState>>& out);
@@ -102,6 +113,21 @@ class TaskSearch {
   bool AssemblyPossible(const Milestone& m, std::string* why);
   PlanAction MakeAction(const SymState& s, const TaskAction& a, const EdgeOutcome& e,
                         int milestone) const;
+
+  /// The backward abstraction of the current milestone (backward.cpp).
+  struct Backward {
+    bool valid = false;
+    int step = -1, moved = -1, base = -1;
+    int loc0[2] = {-1, -1};    ///< Start location of each input (-1: held).
+    int n_place[2] = {0, 0};   ///< Placements of each input in the abstraction.
+    int n_rest[2] = {0, 0};    ///< Rest statuses: the start location, then the placements.
+    int n_status[2] = {0, 0};  ///< Rest statuses, then (robot, grasp class) pairs.
+    std::unordered_map<int, bool> assembly_grasp[2];  ///< Grasp id -> assembly class.
+    std::vector<int> dist;     ///< Per (moved status, base status): actions to the assembly.
+    std::string why;           ///< Why the start is kFarDistance away (empty otherwise).
+  };
+  Backward backward_;
+  bool use_backward_ = false;  ///< planner "wrap": the backward heuristic replaces counting.
 
   const TaskWorld& world_;
   TaskTables& tables_;
@@ -129,6 +155,7 @@ class TaskSearch {
   long long expansions_ = 0;
   int widenings_ = 0;
   double search_s_ = 0.0;
+  double bwd_s_ = 0.0;
   GateTally tally_;
 };
 

@@ -92,10 +92,71 @@ TEST_P(ExamplePlan, IsSolvedAndValid) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Projects, ExamplePlan,
-                         ::testing::Values("stool", "half_stool", "chair", "cross", "cube",
-                                           "cube_2x2x3", "fabrica_plumbers_block",
+                         ::testing::Values("stool", "half_stool", "chair", "cross",
+                                           "cross_openarm", "cube", "cube_2x2x3",
+                                           "fabrica_plumbers_block", "fabrica_beam",
+                                           "fabrica_car"),
+                         [](const auto& param_info) { return param_info.param; });
+
+// The WRAP variant (backward abstract heuristic) on the projects it solves fast; its plans pass
+// the same validator and its stats hold the backward search's time.
+class WrapPlan : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(WrapPlan, IsSolvedAndValid) {
+  const fs::path file = ProjectFile(GetParam());
+  const LoadedProject lp = LoadProject(file);
+  if (!lp.ok() && GetParam().starts_with("fabrica")) {
+    GTEST_SKIP() << "the Fabrica meshes are not beside the repository (../shared/fabrica)";
+  }
+  ASSERT_TRUE(lp.ok()) << GetParam();
+  TaskPlannerOptions options;
+  options.planner = "wrap";
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 240.0, options);
+  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
+  ASSERT_TRUE(run.plan->stats.solved) << GetParam() << ": " << run.plan->stats.failure;
+  EXPECT_EQ(run.plan->stats.planner, "wrap");
+  EXPECT_GT(run.plan->stats.t_bwd_s, 0.0);
+  ASSERT_TRUE(run.validation.has_value());
+  EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
+}
+
+INSTANTIATE_TEST_SUITE_P(Projects, WrapPlan,
+                         ::testing::Values("stool", "cross", "cube", "fabrica_car",
                                            "fabrica_beam"),
                          [](const auto& param_info) { return param_info.param; });
+
+// When the backward abstraction cannot reach a step's assembly, WRAP says why at once instead of
+// searching: here wheel0 has lost every grasp (and the wrench model is off, so that the wrench
+// pre-check of the step does not answer first).
+TEST(WrapPlanInfeasible, NoAssemblyGraspIsExplained) {
+  const fs::path file = ProjectFile("fabrica_car");
+  const LoadedProject lp = LoadProject(file);
+  if (!lp.ok()) GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
+  RunContext ctx(0);
+  PreprocessOptions pre_options;
+  pre_options.project_file = file;
+  auto pre = Preprocess(*lp.project, lp.check, pre_options, ctx);
+  ASSERT_TRUE(pre.has_value()) << pre.error().message;
+  Subassembly* wheel = nullptr;
+  for (Subassembly& sub : pre->subassemblies) {
+    if (sub.name == "wheel0") wheel = &sub;
+  }
+  ASSERT_NE(wheel, nullptr);
+  for (GraspSet& set : wheel->grasp_sets) set.grasps.clear();
+  TaskPlannerOptions options;
+  options.planner = "wrap";
+  options.wrench_mode = MatingWrenchMode::kNone;
+  options.project_file = file;
+  RunContext plan_ctx(0);
+  plan_ctx.set_time_limit_s(60.0);
+  auto plan = PlanTask(*lp.project, lp.check, *pre, options, plan_ctx);
+  ASSERT_TRUE(plan.has_value()) << plan.error().message;
+  EXPECT_FALSE(plan->stats.solved);
+  EXPECT_NE(plan->stats.failure.find("chassis+wheel0"), std::string::npos) << plan->stats.failure;
+  EXPECT_NE(plan->stats.failure.find("no robot has a grasp of 'wheel0'"), std::string::npos)
+      << plan->stats.failure;
+  EXPECT_LT(plan->stats.t_init_s, 10.0);
+}
 
 // The cross with 2 and 3 of its 4 robots (the paper's scaling in robots).
 class CrossRobots : public ::testing::TestWithParam<int> {};
