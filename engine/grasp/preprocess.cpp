@@ -72,40 +72,50 @@ double LineDistance(const Vec3& c, const Vec3& x, const Vec3& u) {
   return (c - x - (c - x).dot(u) * u).norm();
 }
 
-// Farthest-point order of n items: start from the best quality, then repeatedly the item
-// farthest (position, plus approach angle times rot_scale) from those chosen, mildly weighted by
-// quality. Ties go to the lower index: deterministic. Stops early (short) when ctx says so.
+// Farthest-point order of up to n more items from `among` (indices into x, a, quality): the
+// item farthest (position, plus approach angle times rot_scale) from those already `chosen` and
+// picked so far, mildly weighted by quality; with nothing chosen yet, the best quality first.
+// Items that coincide with a chosen one are never picked. Ties go to the lower index:
+// deterministic. Stops early (short) when ctx says so.
 std::vector<int> FarthestPointOrder(const std::vector<Vec3>& x, const std::vector<Vec3>& a,
-                                    const std::vector<double>& quality, int n, double rot_scale,
-                                    const RunContext& ctx) {
-  const int m = static_cast<int>(x.size());
+                                    const std::vector<double>& quality,
+                                    const std::vector<int>& among, const std::vector<int>& chosen,
+                                    int n, double rot_scale, const RunContext& ctx) {
+  const int m = static_cast<int>(among.size());
   std::vector<int> order;
   if (m == 0 || n <= 0) return order;
-  int next = 0;
-  for (int i = 1; i < m; ++i) {
-    if (quality[i] > quality[next]) next = i;
-  }
   std::vector<double> min_dist(m, std::numeric_limits<double>::infinity());
   std::vector<char> taken(m, 0);
-  while (next >= 0 && static_cast<int>(order.size()) < n) {
-    if (order.size() % 16 == 15 && ctx.ShouldStop()) break;
-    order.push_back(next);
-    taken[next] = 1;
+  auto account = [&](int item) {
     for (int i = 0; i < m; ++i) {
       if (taken[i]) continue;
-      const double ang = rot_scale * AngleBetween(a[i], a[next]);
-      min_dist[i] = std::min(min_dist[i], std::sqrt((x[i] - x[next]).squaredNorm() + ang * ang));
+      const int k = among[i];
+      const double ang = rot_scale * AngleBetween(a[k], a[item]);
+      min_dist[i] = std::min(min_dist[i], std::sqrt((x[k] - x[item]).squaredNorm() + ang * ang));
     }
-    next = -1;
+  };
+  for (int c : chosen) account(c);
+  auto pick_next = [&]() {
+    int next = -1;
     double best = -1.0;
     for (int i = 0; i < m; ++i) {
-      if (taken[i]) continue;
-      const double score = min_dist[i] * (0.75 + 0.25 * quality[i]);
+      if (taken[i] || min_dist[i] < 1e-9) continue;
+      const double score = std::isinf(min_dist[i]) ? quality[among[i]]
+                                                   : min_dist[i] * (0.75 + 0.25 * quality[among[i]]);
       if (score > best) {
         best = score;
         next = i;
       }
     }
+    return next;
+  };
+  int next = pick_next();
+  while (next >= 0 && static_cast<int>(order.size()) < n) {
+    if (order.size() % 16 == 15 && ctx.ShouldStop()) break;
+    order.push_back(among[next]);
+    taken[next] = 1;
+    account(among[next]);
+    next = pick_next();
   }
   return order;
 }
@@ -411,17 +421,12 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
                               : (c.slack + c.pad_fraction + com_term) / 3.0);
       }
     }
-    // Spread picks among a subset of the candidates, as indices into `kept`.
+    // Spread picks among a subset of the candidates (indices into `kept`), away from every grasp
+    // already in the set.
+    std::vector<int> chosen;
     auto spread = [&](const std::vector<int>& among, int n) {
-      std::vector<Vec3> xs, as;
-      std::vector<double> qs;
-      for (int i : among) {
-        xs.push_back(x[i]);
-        as.push_back(a[i]);
-        qs.push_back(quality[i]);
-      }
-      std::vector<int> picked;
-      for (int j : FarthestPointOrder(xs, as, qs, n, 0.1 * diag, ctx)) picked.push_back(among[j]);
+      std::vector<int> picked = FarthestPointOrder(x, a, quality, among, chosen, n, 0.1 * diag, ctx);
+      chosen.insert(chosen.end(), picked.begin(), picked.end());
       return picked;
     };
     // Tiers: assembly and pick, assembly only, pick only, neither.
