@@ -133,6 +133,28 @@ bool KeyframeSolver::GripperClear(int robot, int grasp, const Iso3& X_WA, int ot
   return !hit;
 }
 
+bool KeyframeSolver::ClearOfHomes(int node, const Iso3& X_WA) {
+  ++counters_.collision_checks;
+  CollisionWorld& w = cell_.world();
+  for (int p : world_.tree->nodes[node].parts) cell_.SetObjectPose(p, X_WA * world_.X_AP[p]);
+  for (int r = 0; r < static_cast<int>(world_.robots.size()); ++r) {
+    SetRobot(r, world_.robots[r].home);
+    std::vector<BodyId> bodies = {cell_.end_effector_body(r)};
+    const int links = static_cast<int>(world_.robots[r].chain.links.size());
+    for (int i = 0; i < links; ++i) bodies.push_back(cell_.link_body(r, i));
+    if (fingers_[r]) {
+      for (int k = 0; k < 2; ++k) bodies.push_back(fingers_[r]->body[k]);
+    }
+    for (int p : world_.tree->nodes[node].parts) {
+      for (BodyId b : bodies) {
+        if (w.Collide(b, cell_.object_body(p))) return false;
+      }
+    }
+  }
+  // Every validation sets the robots and the scene again before it checks anything.
+  return true;
+}
+
 double KeyframeSolver::GraspOpening(int grasp) const {
   return tables_.grasp(grasp).width_m + 0.002;
 }

@@ -84,6 +84,9 @@ class KeyframeSolver {
   /// Cheap and context-free: the gripper of `robot` at `grasp` on an object at X_WA (fingers
   /// closed to the grasp) does not touch the parts of `other_node` at X_other.
   bool GripperClear(int robot, int grasp, const Iso3& X_WA, int other_node, const Iso3& X_other);
+  /// Cheap and context-free: `node` resting at X_WA leaves every robot room to stand at home
+  /// (no link, end effector or finger of a robot at its home configuration touches it).
+  bool ClearOfHomes(int node, const Iso3& X_WA);
   /// Finger opening of a robot holding with `grasp` (width plus clearance).
   double GraspOpening(int grasp) const;
   /// The wrench gate for `objects` (cached by `key`, which must identify the question), with the

@@ -241,6 +241,12 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
   return ok;
 }
 
+bool TaskSearch::HomesClear(int node, int loc) {
+  auto [it, inserted] = homes_clear_.try_emplace(HashMix(node, loc), true);
+  if (inserted) it->second = solver_.ClearOfHomes(node, tables_.location(loc).X_WA);
+  return it->second;
+}
+
 bool TaskSearch::CheapPlace(int robot, int node, int loc, int grasp) {
   std::uint64_t key = HashMix(HashMix(HashMix(HashMix(102, robot), node), loc), grasp);
   if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(key, it->second);
@@ -254,6 +260,11 @@ bool TaskSearch::CheapPlace(int robot, int node, int loc, int grasp) {
     tally_.Add(Gate::kCollision, "setting '" + world_.tree->nodes[node].name + "' down with grasp " +
                                      std::to_string(tables_.grasp(grasp).index) +
                                      " puts the gripper into the table");
+  }
+  if (ok && !HomesClear(node, loc)) {
+    ok = false;
+    tally_.Add(Gate::kCollision, "'" + world_.tree->nodes[node].name +
+                                     "' set down there would be in the way of a robot at home");
   }
   if (ok) {
     std::string why;
@@ -326,6 +337,12 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
       std::string solo;
       ok = solver_.SoloReach(r, {{m.moved, X_WB, m_touches}, {m.base, X_WB, true}}, g, &solo);
       if (!ok) tally_.Add(Gate::kIk, solo + " to insert '" + world_.tree->nodes[m.moved].name + "'");
+    }
+    if (ok && !solver_.ClearOfHomes(m.step, X_WB)) {
+      ok = false;
+      tally_.Add(Gate::kCollision, "'" + world_.tree->nodes[m.step].name + "' built where '" +
+                                       world_.tree->nodes[m.base].name +
+                                       "' rests would be in the way of a robot at home");
     }
     if (ok && LowestPoint(world_, m.moved, X_WB) < world_.table_top - 1e-3) {
       ok = false;

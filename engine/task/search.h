@@ -106,6 +106,8 @@ class TaskSearch {
   bool CheapPick(int robot, int node, int loc, int grasp);
   bool CheapPlace(int robot, int node, int loc, int grasp);
   bool CheapAssemble(const SymState& s, const Milestone& m);
+  /// `node` resting at location `loc` leaves every robot room at home (cached).
+  bool HomesClear(int node, int loc);
   bool GraspsApart(int grasp_a, int grasp_b) const;
   /// Abstract check before a milestone: some grasps of the moved input (one or two) and some
   /// support of the base (held by one gripper in some orientation, or resting in some
@@ -150,6 +152,7 @@ class TaskSearch {
   void Remember(std::uint64_t key, bool ok);  // caches with the last tallied reason
   std::unordered_map<std::uint64_t, CheapAnswer> cheap_;  // cheap-check answers
   std::unordered_set<std::uint64_t> tallied_;  // cheap failures tallied in this milestone
+  std::unordered_map<std::uint64_t, bool> homes_clear_;  // HomesClear per (node, location)
   std::map<int, std::pair<bool, std::string>> possible_;  // AssemblyPossible per step
   std::vector<Iso3> placement_pose_;                       // scratch
   long long expansions_ = 0;

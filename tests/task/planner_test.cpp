@@ -13,7 +13,9 @@
 #include "model/validate.h"
 #include "task/plan_json.h"
 #include "task/plan_validator.h"
+#include "task/keyframes.h"
 #include "task/planner.h"
+#include "task/world.h"
 
 namespace wrap {
 namespace {
@@ -60,6 +62,35 @@ std::string Issues(const PlanValidation& v) {
   std::string out;
   for (const PlanIssue& i : v.issues) out += FormatIssue(i) + "\n";
   return out;
+}
+
+// An object set down where a robot's home pose reaches (here: right at ur5e_a's base) would leave
+// that robot nowhere to go: ClearOfHomes says so; the seat where it starts leaves every home free.
+TEST(KeyframeSolver, ObjectsInTheWayOfAHomeAreFlagged) {
+  const fs::path file = ProjectFile("stool");
+  const LoadedProject lp = LoadProject(file);
+  ASSERT_TRUE(lp.ok());
+  RunContext ctx(0);
+  PreprocessOptions pre_options;
+  pre_options.project_file = file;
+  auto pre = Preprocess(*lp.project, lp.check, pre_options, ctx);
+  ASSERT_TRUE(pre.has_value()) << pre.error().message;
+  auto world = BuildTaskWorld(*lp.project, lp.check, *pre, file);
+  ASSERT_TRUE(world.has_value()) << world.error().message;
+  CellOptions cell_options;
+  cell_options.objects_touch_table = false;
+  auto cell = Cell::Build(world->cell_def, cell_options);
+  ASSERT_TRUE(cell.has_value()) << cell.error().message;
+  TaskTables tables;
+  TaskCounters counters;
+  TaskPlannerOptions options;
+  KeyframeSolver solver(*world, tables, options, std::move(*cell), counters);
+  const int seat = 0;
+  ASSERT_EQ(world->tree->nodes[seat].name, "seat");
+  EXPECT_TRUE(solver.ClearOfHomes(seat, world->initial_X_WA[seat]));
+  Iso3 at_base = world->initial_X_WA[seat];
+  at_base.translation().head<2>() = world->robots[0].X_WB.translation().head<2>();
+  EXPECT_FALSE(solver.ClearOfHomes(seat, at_base));
 }
 
 // Every example project is planned within a generous limit and the plan passes the validator.
