@@ -34,10 +34,9 @@ constexpr int kFar = TaskSearch::kFarDistance;
 bool TaskSearch::AssemblyGrasp(int input, int robot, int grasp) {
   auto& classes = backward_.assembly_grasp[input];
   if (auto it = classes.find(grasp); it != classes.end()) return it->second;
-  const int node = input == 0 ? backward_.moved : backward_.base;
   const int other = input == 0 ? backward_.base : backward_.moved;
-  (void)node;
-  const bool ok = solver_.GripperClear(robot, grasp, Iso3::Identity(), other, Iso3::Identity());
+  const bool ok =
+      solver_.GripperClear(robot, grasp, Iso3::Identity(), other, Iso3::Identity());
   classes.emplace(grasp, ok);
   return ok;
 }
@@ -67,6 +66,19 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
       rest_pose[k].push_back(PlacementPose(slots.slots[0], 0.0, placements[p]));
     }
   }
+  // Robots with the same end effector and the project's wrench limits answer the robot-free
+  // questions (table clearance, the wrench LP) alike: `same_as[r]` is the first such robot.
+  std::vector<int> same_as(R);
+  for (int r = 0; r < R; ++r) {
+    same_as[r] = r;
+    for (int q = 0; q < r; ++q) {
+      if (world_.robots[q].grasp_set == world_.robots[r].grasp_set &&
+          !world_.project->robots[q].wrench_limits && !world_.project->robots[r].wrench_limits) {
+        same_as[r] = q;
+        break;
+      }
+    }
+  }
   auto grasps = [&](int k, int r) {
     const std::vector<int>& ids = GraspIds(nodes[k], r);
     return std::span<const int>(ids.data(),
@@ -75,7 +87,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
 
   // pick[k][i][r][c] (also place for i > 0): some grasp of class c of robot r takes input k
   // from rest status i.
-  auto idx_pick = [&](int k, int i, int r, int c) { return ((i * R) + r) * 2 + c; };
+  auto idx_pick = [&](int /*input*/, int i, int r, int c) { return ((i * R) + r) * 2 + c; };
   std::vector<char> pick[2];
   for (int k = 0; k < 2; ++k) {
     pick[k].assign(static_cast<size_t>(b.n_rest[k]) * R * 2, 0);
@@ -88,6 +100,10 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
         }
         for (int p = 0; p < b.n_place[k]; ++p) {
           char& slot = pick[k][idx_pick(k, 1 + p, r, c)];
+          if (same_as[r] != r) {
+            slot = pick[k][idx_pick(k, 1 + p, same_as[r], c)];
+            continue;
+          }
           if (slot) continue;
           const Iso3 target = solver_.GraspTarget(rest_pose[k][1 + p], g);
           if (solver_.ClearOfTable(r, target, solver_.GraspOpening(g))) slot = 1;
@@ -141,7 +157,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
   // status i: the moved input stays above the table, the gripper clears it, and (budgeted) the
   // assembly LP holds for some grasp, alone or with a brace (cost 2 then).
   const bool wrench = options_.wrench_mode != MatingWrenchMode::kNone;
-  long long lp_budget = 600;
+  long long lp_budget = 150;
   std::vector<int> rest_asm(static_cast<size_t>(b.n_rest[1]) * R, 0);  // 0 no, 1 ok, 2 braced
   for (int i = 0; i < b.n_rest[1]; ++i) {
     if (i == 0 && b.loc0[1] < 0) continue;
@@ -152,6 +168,10 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
     const int loc = i == 0 ? b.loc0[1] : tables_.PlacedLocation(m.base, i - 1, 0, 0, X);
     for (int r = 0; r < R; ++r) {
       int best = 0;
+      if (i > 0 && same_as[r] != r) {  // a placement: wherever on the table, the same answers
+        rest_asm[static_cast<size_t>(i) * R + r] = rest_asm[static_cast<size_t>(i) * R + same_as[r]];
+        continue;
+      }
       for (int g : grasps(0, r)) {
         if (best == 1) break;
         if (!AssemblyGrasp(0, r, g)) continue;
@@ -176,7 +196,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
   // air_asm[r_m][r_b]: the moved input held by r_m and the base by r_b, both with assembly
   // grasps, balance the mating wrench in some orientation (budgeted).
   std::vector<char> air_asm(static_cast<size_t>(R * R), 0);
-  long long air_budget = 40;
+  long long air_budget = 12;
   for (int rm = 0; rm < R; ++rm) {
     for (int rb = 0; rb < R; ++rb) {
       if (rm == rb) continue;

@@ -31,9 +31,9 @@ std::string ModeName(MatingWrenchMode mode) {
 Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const Preprocessed& pre,
                       const TaskPlannerOptions& options, RunContext& ctx) {
   const auto start = Clock::now();
-  if (options.planner != "counting" && options.planner != "wrap") {
+  if (options.planner != "counting" && options.planner != "wrap" && options.planner != "exact") {
     return Fail(ErrorCode::kInvalidInput,
-                "planner: unknown variant '" + options.planner + "' (known: wrap, counting)");
+                "planner: unknown variant '" + options.planner + "' (known: wrap, exact, counting)");
   }
   if (!(options.force_scale >= 0.0) || !std::isfinite(options.force_scale)) {
     return Fail(ErrorCode::kInvalidInput, "planner: --force-scale must be finite and >= 0");

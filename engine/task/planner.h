@@ -9,6 +9,12 @@
 // candidate plan; witnesses are cached; an edge that fails at one effort level is suspended and
 // revisited at the next; grasp and placement subsets are widened when a milestone fails; a
 // milestone that fails makes the previous one look for another end state (backtracking).
+//
+// "wrap" replaces the counting heuristic by WRAP's backward abstract heuristic (search.h,
+// backward.cpp): per milestone a breadth-first search backwards from the assembly over the two
+// inputs' projected status (resting where they start or in a placement; held by a robot with an
+// assembly grasp or another one); "exact" is the paper's "exact fills": the same with f = g + h
+// instead of f = g + 2 h.
 #pragma once
 
 #include <filesystem>
@@ -26,7 +32,8 @@ namespace wrap {
 
 /// Options of PlanTask.
 struct TaskPlannerOptions {
-  std::string planner = "counting";  ///< Variant; "counting" (Milestones + counting).
+  std::string planner = "counting";  ///< Variant: "counting" (Milestones + counting), "wrap"
+                                     ///< (backward abstract heuristic), "exact" (wrap, weight 1).
   MatingWrenchMode wrench_mode = MatingWrenchMode::kFull;  ///< full, gravity or none.
   double force_scale = 1.0;      ///< Lambda on the mating force and torque, >= 0.
   double min_clearance_m = 0.005;  ///< Least distance between two robots at a keyframe [m].

@@ -17,7 +17,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr int kPermanent = INT_MAX;
-constexpr int kWeight = 2;  // weighted best-first: f = g + 2 h
 // Node budget of a search from a committed state past the milestone's start: beyond it the
 // state counts as a dead end and the search backs up.
 constexpr long long kLocalNodes = 20000;
@@ -83,7 +82,8 @@ TaskSearch::TaskSearch(const TaskWorld& world, TaskTables& tables, KeyframeSolve
       seed_(seed),
       widen_(widen),
       n_robots_(static_cast<int>(world.robots.size())),
-      use_backward_(options.planner == "wrap") {}
+      use_backward_(options.planner == "wrap" || options.planner == "exact"),
+      weight_(options.planner == "exact" ? 1 : 2) {}
 
 TaskSearch::Resolution TaskSearch::ResolutionAt(int level) const {
   constexpr int kGrasps[] = {6, 12, 1 << 20};
@@ -512,7 +512,7 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milesto
   long long sequence = 0;
   nodes_.push_back({s0, 0, -1, {}});
   best_g[s0.Hash()] = 0;
-  open.push({kWeight * Heuristic(s0, m), 0, sequence++, 0});
+  open.push({weight_ * Heuristic(s0, m), 0, sequence++, 0});
   std::vector<std::pair<TaskAction, SymState>> successors;
   while (!open.empty()) {
     if ((++expansions_ & 127) == 0 && ctx_.ShouldStop()) return SearchStatus::kStopped;
@@ -545,7 +545,7 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milesto
       }
       const int child = static_cast<int>(nodes_.size());
       nodes_.push_back({std::move(s2), g2, index, a});
-      open.push({g2 + kWeight * Heuristic(nodes_[child].s, m), -g2, sequence++, child});
+      open.push({g2 + weight_ * Heuristic(nodes_[child].s, m), -g2, sequence++, child});
     }
   }
   return SearchStatus::kExhausted;

@@ -129,7 +129,6 @@ class TaskSearch {
     std::string why;           ///< Why the start is kFarDistance away (empty otherwise).
   };
   Backward backward_;
-  bool use_backward_ = false;  ///< planner "wrap": the backward heuristic replaces counting.
 
   const TaskWorld& world_;
   TaskTables& tables_;
@@ -139,6 +138,8 @@ class TaskSearch {
   std::uint64_t seed_;
   bool widen_;
   int n_robots_ = 0;
+  bool use_backward_ = false;  ///< wrap, exact: the backward heuristic replaces counting.
+  int weight_ = 2;             ///< f = g + weight h: 2 (weighted best-first), 1 for "exact".
   std::vector<Node> nodes_;
   std::map<std::pair<int, int>, std::vector<int>> grasp_ids_;
   std::unordered_map<std::uint64_t, int> failed_level_;   // edge key -> level failed at

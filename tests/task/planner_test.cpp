@@ -152,9 +152,24 @@ TEST_P(WrapPlan, IsSolvedAndValid) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Projects, WrapPlan,
-                         ::testing::Values("stool", "cross", "cube", "fabrica_car",
-                                           "fabrica_beam"),
+                         ::testing::Values("stool", "cross", "cube", "cube_2x2x3",
+                                           "fabrica_car", "fabrica_beam"),
                          [](const auto& param_info) { return param_info.param; });
+
+// "exact" (the paper's exact fills: the backward heuristic with weight-one A*) shares the rest.
+TEST(ExactPlan, CrossIsSolvedAndValid) {
+  const fs::path file = ProjectFile("cross");
+  const LoadedProject lp = LoadProject(file);
+  ASSERT_TRUE(lp.ok());
+  TaskPlannerOptions options;
+  options.planner = "exact";
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 240.0, options);
+  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
+  ASSERT_TRUE(run.plan->stats.solved) << run.plan->stats.failure;
+  EXPECT_EQ(run.plan->stats.planner, "exact");
+  ASSERT_TRUE(run.validation.has_value());
+  EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
+}
 
 // When the backward abstraction cannot reach a step's assembly, WRAP says why at once instead of
 // searching: here wheel0 has lost every grasp (and the wrench model is off, so that the wrench
