@@ -843,7 +843,9 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
       }
       std::vector<PlanObject> objs_a;
       for (int node : keyframe_nodes) objs_a.push_back({node, Xa[node], keyframe_resting[node]});
-      SetScene(objs_a, holds_at_keyframe, -1, -1);
+      // The moved input may touch the base along its insertion (faces that slide along each
+      // other, as in a stack of cubes); everything else must be clear.
+      SetScene(objs_a, holds_at_keyframe, st.moved, st.base);
       for (size_t i = 0; i < movers.size(); ++i) SetRobot(movers[i].robot, qa[i]);
       bool hit = Collides();
       if (!hit && n_robots >= 2) {  // The robots' clearance holds at the approach too.

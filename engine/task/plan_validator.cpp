@@ -1156,6 +1156,8 @@ void Validator::ReplayAction(int i) {
                                        " back along the insertion axis from " + Quote(NodeName(B)) +
                                        ")"};
         if (base_moves) ap.required[B] = {X_WB, "its pose at the assemble keyframe"};
+        // Along the insertion the moved input may slide on the base (touching faces).
+        ap.allowed_pairs.emplace_back(M, B);
         CheckKeyframe(i, "approach: ", *a.approach, ap);
       } else {
         Issue(i, "pose", "assemble has no approach keyframe");
