@@ -306,30 +306,18 @@ Result<TaskWorld> BuildTaskWorld(const Project& project, const ProjectCheck& che
 std::vector<std::pair<int, std::vector<Vec3>>> TableContacts(const TaskWorld& world, int node,
                                                              const Iso3& X_WA,
                                                              double tolerance_m) {
-  const Subassembly& sub = world.pre->subassemblies[node];
+  // Each part's own hull vertices (a part's node is its subassembly), as the plan validator
+  // counts them: a vertex shared by two touching parts supports both.
   const AssemblyNode& n = world.tree->nodes[node];
   std::vector<std::pair<int, std::vector<Vec3>>> out;
-  for (const Vec3& v_A : sub.hull.mesh.vertices) {
-    const Vec3 v_W = X_WA * v_A;
-    if (v_W.z() > world.table_top + tolerance_m) continue;
-
-    // The part whose box is nearest to the vertex.
-    int best = n.parts.front();
-    double best_d = std::numeric_limits<double>::infinity();
-    for (int p : n.parts) {
-      const Aabb& b = world.part_box_A[p];
-      const double d = (v_A - v_A.cwiseMax(b.min).cwiseMin(b.max)).norm();
-      if (d < best_d) {
-        best_d = d;
-        best = p;
-      }
+  for (int part : n.parts) {
+    std::vector<Vec3> points;
+    for (const Vec3& v_A : world.pre->subassemblies[part].hull.mesh.vertices) {  // in A
+      const Vec3 v_W = X_WA * v_A;
+      if (v_W.z() > world.table_top + tolerance_m) continue;
+      points.push_back(Vec3(v_W.x(), v_W.y(), world.table_top));
     }
-    auto it = std::find_if(out.begin(), out.end(), [&](const auto& e) { return e.first == best; });
-    if (it == out.end()) {
-      out.push_back({best, {}});
-      it = out.end() - 1;
-    }
-    it->second.push_back(Vec3(v_W.x(), v_W.y(), world.table_top));
+    if (!points.empty()) out.push_back({part, std::move(points)});
   }
   const Vec3 half = 0.5 * world.project->table.size;
   for (auto& [part, points] : out) {

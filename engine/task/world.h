@@ -86,8 +86,9 @@ Result<TaskWorld> BuildTaskWorld(const Project& project, const ProjectCheck& che
                                  const Preprocessed& pre,
                                  const std::filesystem::path& project_file);
 
-/// Hull vertices of `node`'s subassembly (in A) that touch the table when A is at X_WA, grouped
-/// by part: pairs (part index, world points), at most 16 points per part (their 2-D hull).
+/// Each part's own hull vertices that touch the table (within `tolerance_m`) when `node`'s frame
+/// A is at X_WA, as the plan validator counts them: pairs (part index, world points on the
+/// table top), at most 16 points per part (their 2-D hull, clipped to the table).
 std::vector<std::pair<int, std::vector<Vec3>>> TableContacts(const TaskWorld& world, int node,
                                                              const Iso3& X_WA,
                                                              double tolerance_m = 2e-3);
