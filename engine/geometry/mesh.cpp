@@ -150,4 +150,21 @@ TriangleMesh Transformed(const TriangleMesh& mesh, const Iso3& X) {
   return out;
 }
 
+TriangleMesh BoxMesh(const Vec3& lo, const Vec3& hi) {
+  TriangleMesh mesh;
+  // Vertex k has x = hi.x when bit 0 of k is set, y when bit 1 is, z when bit 2 is.
+  for (int k = 0; k < 8; ++k) {
+    mesh.vertices.emplace_back((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(),
+                               (k & 4) ? hi.z() : lo.z());
+  }
+  // Each face as a counter-clockwise quad seen from outside, split along its first diagonal.
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    mesh.triangles.emplace_back(q[0], q[1], q[2]);
+    mesh.triangles.emplace_back(q[0], q[2], q[3]);
+  }
+  return mesh;
+}
+
 }  // namespace wrap

@@ -58,4 +58,7 @@ MassProperties ComputeMassProperties(const TriangleMesh& mesh);
 /// The mesh with every vertex mapped through `X` (triangles unchanged).
 TriangleMesh Transformed(const TriangleMesh& mesh, const Iso3& X);
 
+/// Closed box from `lo` to `hi` [m]: 8 vertices, 12 triangles counter-clockwise seen from outside.
+TriangleMesh BoxMesh(const Vec3& lo, const Vec3& hi);
+
 }  // namespace wrap

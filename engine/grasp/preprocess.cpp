@@ -51,22 +51,6 @@ constexpr int kPickPlacements = 3;
 // angle's cosine (15 degrees) of the insertion direction.
 constexpr double kVacuumPushCos = 0.966;
 
-// A box of half extents h centred at c, triangles counter-clockwise seen from outside.
-TriangleMesh BoxMesh(const Vec3& c, const Vec3& h) {
-  TriangleMesh m;
-  for (int i = 0; i < 8; ++i) {
-    m.vertices.push_back(c + Vec3((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
-                                  (i & 4) ? h.z() : -h.z()));
-  }
-  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& f : faces) {
-    m.triangles.emplace_back(f[0], f[1], f[2]);
-    m.triangles.emplace_back(f[0], f[2], f[3]);
-  }
-  return m;
-}
-
 // Distance of point c from the line through x along unit u [m].
 double LineDistance(const Vec3& c, const Vec3& x, const Vec3& u) {
   return (c - x - (c - x).dot(u) * u).norm();
@@ -264,7 +248,7 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
   }
   // The table as one more body: its top is the plane z = 0 of this frame, wide enough for any
   // part (grasps are tested against it in the rest frame of a placement).
-  const TriangleMesh table_box = BoxMesh(Vec3(0.0, 0.0, -0.05), Vec3(5.0, 5.0, 0.05));
+  const TriangleMesh table_box = BoxMesh(Vec3(-5.0, -5.0, -0.1), Vec3(5.0, 5.0, 0.0));
   const int table_body = num_parts;
   meshes.push_back(&table_box);
   X_AP.push_back(Iso3::Identity());

@@ -3,6 +3,7 @@
 // cancellation and the time limit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <stop_token>
@@ -129,47 +130,40 @@ INSTANTIATE_TEST_SUITE_P(Projects, ExamplePlan,
                                            "fabrica_car"),
                          [](const auto& param_info) { return param_info.param; });
 
-// The WRAP variant (backward abstract heuristic) on the projects it solves fast; its plans pass
-// the same validator and its stats hold the backward search's time.
+// The backward-heuristic variants ("wrap"; "exact": the paper's exact fills, weight-one A*) on
+// projects they solve fast; their plans pass the same validator and their stats hold the
+// backward search's time. Parameter: "variant/project".
 class WrapPlan : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(WrapPlan, IsSolvedAndValid) {
-  const fs::path file = ProjectFile(GetParam());
+  const std::string variant = GetParam().substr(0, GetParam().find('/'));
+  const std::string project = GetParam().substr(GetParam().find('/') + 1);
+  const fs::path file = ProjectFile(project);
   const LoadedProject lp = LoadProject(file);
-  if (!lp.ok() && GetParam().starts_with("fabrica")) {
+  if (!lp.ok() && project.starts_with("fabrica")) {
     GTEST_SKIP() << "the Fabrica meshes are not beside the repository (../shared/fabrica)";
   }
-  ASSERT_TRUE(lp.ok()) << GetParam();
+  ASSERT_TRUE(lp.ok()) << project;
   TaskPlannerOptions options;
-  options.planner = "wrap";
+  options.planner = variant;
   const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 240.0, options);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   ASSERT_TRUE(run.plan->stats.solved) << GetParam() << ": " << run.plan->stats.failure;
-  EXPECT_EQ(run.plan->stats.planner, "wrap");
+  EXPECT_EQ(run.plan->stats.planner, variant);
   EXPECT_GT(run.plan->stats.t_bwd_s, 0.0);
   ASSERT_TRUE(run.validation.has_value());
   EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
 }
 
 INSTANTIATE_TEST_SUITE_P(Projects, WrapPlan,
-                         ::testing::Values("stool", "cross", "cube", "cube_2x2x3",
-                                           "fabrica_car", "fabrica_beam"),
-                         [](const auto& param_info) { return param_info.param; });
-
-// "exact" (the paper's exact fills: the backward heuristic with weight-one A*) shares the rest.
-TEST(ExactPlan, CrossIsSolvedAndValid) {
-  const fs::path file = ProjectFile("cross");
-  const LoadedProject lp = LoadProject(file);
-  ASSERT_TRUE(lp.ok());
-  TaskPlannerOptions options;
-  options.planner = "exact";
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 240.0, options);
-  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
-  ASSERT_TRUE(run.plan->stats.solved) << run.plan->stats.failure;
-  EXPECT_EQ(run.plan->stats.planner, "exact");
-  ASSERT_TRUE(run.validation.has_value());
-  EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
-}
+                         ::testing::Values("wrap/stool", "wrap/cross", "wrap/cube",
+                                           "wrap/cube_2x2x3", "wrap/fabrica_car",
+                                           "wrap/fabrica_beam", "exact/cross"),
+                         [](const auto& param_info) {
+                           std::string name = param_info.param;
+                           std::replace(name.begin(), name.end(), '/', '_');
+                           return name;
+                         });
 
 // When the backward abstraction cannot reach a step's assembly, WRAP says why at once instead of
 // searching: here wheel0 has lost every grasp (and the wrench model is off, so that the wrench
