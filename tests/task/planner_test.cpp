@@ -27,6 +27,14 @@ fs::path ProjectFile(const std::string& name) {
   return fs::path(WRAP_SOURCE_DIR) / "projects" / (name + ".json");
 }
 
+// Preprocesses `lp`'s project with the default options (seed 0).
+Result<Preprocessed> PreprocessProject(const LoadedProject& lp, const fs::path& file) {
+  RunContext ctx(0);
+  PreprocessOptions options;
+  options.project_file = file;
+  return Preprocess(*lp.project, lp.check, options, ctx);
+}
+
 struct PlanRun {
   Result<Plan> plan = Fail(ErrorCode::kInternal, "not run");
   std::optional<PlanValidation> validation;
@@ -71,10 +79,7 @@ TEST(KeyframeSolver, ObjectsInTheWayOfAHomeAreFlagged) {
   const fs::path file = ProjectFile("stool");
   const LoadedProject lp = LoadProject(file);
   ASSERT_TRUE(lp.ok());
-  RunContext ctx(0);
-  PreprocessOptions pre_options;
-  pre_options.project_file = file;
-  auto pre = Preprocess(*lp.project, lp.check, pre_options, ctx);
+  auto pre = PreprocessProject(lp, file);
   ASSERT_TRUE(pre.has_value()) << pre.error().message;
   auto world = BuildTaskWorld(*lp.project, lp.check, *pre, file);
   ASSERT_TRUE(world.has_value()) << world.error().message;
@@ -172,10 +177,7 @@ TEST(WrapPlanInfeasible, NoAssemblyGraspIsExplained) {
   const fs::path file = ProjectFile("fabrica_car");
   const LoadedProject lp = LoadProject(file);
   if (!lp.ok()) GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
-  RunContext ctx(0);
-  PreprocessOptions pre_options;
-  pre_options.project_file = file;
-  auto pre = Preprocess(*lp.project, lp.check, pre_options, ctx);
+  auto pre = PreprocessProject(lp, file);
   ASSERT_TRUE(pre.has_value()) << pre.error().message;
   Subassembly* wheel = nullptr;
   for (Subassembly& sub : pre->subassemblies) {
