@@ -15,11 +15,13 @@
 // is feasible when some concrete action it stands for passes those checks, so the distances are
 // a relaxation: they count the handovers, regrasps and set-downs the counting heuristic misses.
 #include <algorithm>
+#include <array>
 #include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
+#include <map>
 
 #include "grasp/table_slots.h"
 #include "task/search.h"
@@ -87,21 +89,21 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
 
   // pick[k][i][r][c] (also place for i > 0): some grasp of class c of robot r takes input k
   // from rest status i.
-  auto idx_pick = [&](int /*input*/, int i, int r, int c) { return ((i * R) + r) * 2 + c; };
+  auto idx_pick = [&](int i, int r, int c) { return ((i * R) + r) * 2 + c; };
   std::vector<char> pick[2];
   for (int k = 0; k < 2; ++k) {
     pick[k].assign(static_cast<size_t>(b.n_rest[k]) * R * 2, 0);
     for (int r = 0; r < R; ++r) {
       for (int g : grasps(k, r)) {
         const int c = AssemblyGrasp(k, r, g) ? 1 : 0;
-        if (b.loc0[k] >= 0 && !pick[k][idx_pick(k, 0, r, c)] &&
+        if (b.loc0[k] >= 0 && !pick[k][idx_pick(0, r, c)] &&
             CheapPick(r, nodes[k], b.loc0[k], g)) {
-          pick[k][idx_pick(k, 0, r, c)] = 1;
+          pick[k][idx_pick(0, r, c)] = 1;
         }
         for (int p = 0; p < b.n_place[k]; ++p) {
-          char& slot = pick[k][idx_pick(k, 1 + p, r, c)];
+          char& slot = pick[k][idx_pick(1 + p, r, c)];
           if (same_as[r] != r) {
-            slot = pick[k][idx_pick(k, 1 + p, same_as[r], c)];
+            slot = pick[k][idx_pick(1 + p, same_as[r], c)];
             continue;
           }
           if (slot) continue;
@@ -111,45 +113,28 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
       }
     }
   }
-  // hand[k][(r1, c1), (r2, c2)]: some grasps of the two classes lie apart.
+  // hand[k][(r1, c1), (r2, c2)]: some grasps of the two classes lie apart. The answer depends on
+  // the two robots' grasp sets only: computed once per pair of sets.
   auto idx_hand = [&](int r1, int c1, int r2, int c2) { return ((r1 * 2 + c1) * R + r2) * 2 + c2; };
   std::vector<char> hand[2];
   for (int k = 0; k < 2; ++k) {
     hand[k].assign(static_cast<size_t>(4 * R * R), 0);
+    std::map<std::pair<int, int>, std::array<char, 4>> by_sets;
     for (int r1 = 0; r1 < R; ++r1) {
       for (int r2 = 0; r2 < R; ++r2) {
         if (r1 == r2) continue;
-        // Robots with the same end effector give the same answers.
-        int done_as = -1;
-        for (int q1 = 0; q1 <= r1 && done_as < 0; ++q1) {
-          for (int q2 = 0; q2 < R && done_as < 0; ++q2) {
-            if (q1 == q2 || (q1 == r1 && q2 >= r2)) continue;
-            if (world_.robots[q1].grasp_set == world_.robots[r1].grasp_set &&
-                world_.robots[q2].grasp_set == world_.robots[r2].grasp_set) {
-              done_as = q1 * R + q2;
-            }
+        auto [it, fresh] = by_sets.try_emplace(
+            {world_.robots[r1].grasp_set, world_.robots[r2].grasp_set}, std::array<char, 4>{});
+        std::array<char, 4>& apart = it->second;
+        for (int g1 : grasps(k, r1)) {
+          if (!fresh) break;
+          const int c1 = AssemblyGrasp(k, r1, g1) ? 1 : 0;
+          for (int g2 : grasps(k, r2)) {
+            const int c2 = AssemblyGrasp(k, r2, g2) ? 1 : 0;
+            if (!apart[c1 * 2 + c2] && GraspsApart(g1, g2)) apart[c1 * 2 + c2] = 1;
           }
         }
-        for (int c1 = 0; c1 < 2; ++c1) {
-          for (int c2 = 0; c2 < 2; ++c2) {
-            char& out = hand[k][idx_hand(r1, c1, r2, c2)];
-            if (done_as >= 0) {
-              out = hand[k][idx_hand(done_as / R, c1, done_as % R, c2)];
-              continue;
-            }
-            for (int g1 : grasps(k, r1)) {
-              if (out) break;
-              if ((AssemblyGrasp(k, r1, g1) ? 1 : 0) != c1) continue;
-              for (int g2 : grasps(k, r2)) {
-                if ((AssemblyGrasp(k, r2, g2) ? 1 : 0) != c2) continue;
-                if (GraspsApart(g1, g2)) {
-                  out = 1;
-                  break;
-                }
-              }
-            }
-          }
-        }
+        for (int c = 0; c < 4; ++c) hand[k][idx_hand(r1, c / 2, r2, c % 2)] = apart[c];
       }
     }
   }
@@ -247,13 +232,13 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
           for (int r = 0; r < R; ++r) {
             if (r == other_holder) continue;
             for (int c = 0; c < 2; ++c) {
-              if (pick[k][idx_pick(k, s, r, c)]) add(b.n_rest[k] + 2 * r + c);
+              if (pick[k][idx_pick(s, r, c)]) add(b.n_rest[k] + 2 * r + c);
             }
           }
         } else {
           const int r = (s - b.n_rest[k]) / 2, c = (s - b.n_rest[k]) % 2;
           for (int p = 0; p < b.n_place[k]; ++p) {
-            if (pick[k][idx_pick(k, 1 + p, r, c)]) add(1 + p);
+            if (pick[k][idx_pick(1 + p, r, c)]) add(1 + p);
           }
           for (int r2 = 0; r2 < R; ++r2) {
             if (r2 == r || r2 == other_holder) continue;
@@ -308,7 +293,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
       }
       for (int i = 0; i < b.n_rest[1]; ++i) base_support |= rest_asm[static_cast<size_t>(i) * R + r] > 0;
       for (int q = 0; q < R; ++q) base_support |= air_asm[r * R + q] != 0;
-      m_pick |= pick[0][idx_pick(0, 0, r, 0)] || pick[0][idx_pick(0, 0, r, 1)];
+      m_pick |= pick[0][idx_pick(0, r, 0)] || pick[0][idx_pick(0, r, 1)];
     }
     if (n_all == 0) {
       b.why = "no robot has a grasp of '" + mn + "'";
@@ -339,7 +324,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
           n_asm += AssemblyGrasp(k, r, g) ? 1 : 0;
         }
         std::fprintf(stderr, "r%d %d/%d asm, pick0 %d%d; ", r, n_asm, n,
-                     pick[k][idx_pick(k, 0, r, 0)], pick[k][idx_pick(k, 0, r, 1)]);
+                     pick[k][idx_pick(0, r, 0)], pick[k][idx_pick(0, r, 1)]);
       }
       std::fprintf(stderr, "\n");
     }
