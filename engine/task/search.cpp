@@ -741,6 +741,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
         if (level + 1 < levels) ++widenings_;
         continue;
       }
+      abstract_failure.clear();  // this level searches: its failures are the report
     }
     for (int effort = 0; effort <= options_.max_effort; ++effort) {
       bool suspended_below = false;  // an edge that failed at this effort could be retried
