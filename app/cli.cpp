@@ -90,7 +90,9 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
                    "Wrench model: full (default), gravity (gravity only) or none");
   plan->add_option("--force-scale", plan_args.force_scale,
                    "Scale lambda on the mating force and torque (default 1)");
-  plan->add_option("--planner", plan_args.planner, "Planner variant: counting (Milestones + counting; default), wrap (backward abstract heuristic), exact (wrap with weight-one A* fills)");
+  plan->add_option("--planner", plan_args.planner,
+                   "Planner variant: counting (Milestones + counting; default), wrap (backward "
+                   "abstract heuristic), exact (wrap with weight-one A* fills)");
   plan->add_option("--grasps", plan_args.grasps, "Grasp-set size (default: the project's)")
       ->check(CLI::PositiveNumber);
   plan->add_flag("--validate", plan_args.validate,

@@ -84,8 +84,8 @@ std::vector<int> FarthestPointOrder(const std::vector<Vec3>& x, const std::vecto
     double best = -1.0;
     for (int i = 0; i < m; ++i) {
       if (taken[i] || min_dist[i] < 1e-9) continue;
-      const double score = std::isinf(min_dist[i]) ? quality[among[i]]
-                                                   : min_dist[i] * (0.75 + 0.25 * quality[among[i]]);
+      const double q = quality[among[i]];
+      const double score = std::isinf(min_dist[i]) ? q : min_dist[i] * (0.75 + 0.25 * q);
       if (score > best) {
         best = score;
         next = i;
@@ -409,7 +409,8 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
     // already in the set.
     std::vector<int> chosen;
     auto spread = [&](const std::vector<int>& among, int n) {
-      std::vector<int> picked = FarthestPointOrder(x, a, quality, among, chosen, n, 0.1 * diag, ctx);
+      std::vector<int> picked =
+          FarthestPointOrder(x, a, quality, among, chosen, n, 0.1 * diag, ctx);
       chosen.insert(chosen.end(), picked.begin(), picked.end());
       return picked;
     };

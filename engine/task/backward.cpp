@@ -144,6 +144,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
   const bool wrench = options_.wrench_mode != MatingWrenchMode::kNone;
   long long lp_budget = 150;
   std::vector<int> rest_asm(static_cast<size_t>(b.n_rest[1]) * R, 0);  // 0 no, 1 ok, 2 braced
+  auto asm_at = [&](int i, int r) -> int& { return rest_asm[static_cast<size_t>(i) * R + r]; };
   for (int i = 0; i < b.n_rest[1]; ++i) {
     if (i == 0 && b.loc0[1] < 0) continue;
     const Iso3& X = rest_pose[1][i];
@@ -154,7 +155,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
     for (int r = 0; r < R; ++r) {
       int best = 0;
       if (i > 0 && same_as[r] != r) {  // a placement: wherever on the table, the same answers
-        rest_asm[static_cast<size_t>(i) * R + r] = rest_asm[static_cast<size_t>(i) * R + same_as[r]];
+        asm_at(i, r) = asm_at(i, same_as[r]);
         continue;
       }
       for (int g : grasps(0, r)) {
@@ -175,7 +176,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
                    ? 1
                    : 2;
       }
-      rest_asm[static_cast<size_t>(i) * R + r] = best;
+      asm_at(i, r) = best;
     }
   }
   // air_asm[r_m][r_b]: the moved input held by r_m and the base by r_b, both with assembly
@@ -195,13 +196,11 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
             break;
           }
           const std::vector<std::pair<int, int>> mh = {{rm, gm}}, bh = {{rb, gb}};
-          std::uint64_t key = HashMix(103, m.step);
-          key = HashMix(key, 3);
-          key = HashMix(HashMix(key, rm), gm);
-          key = HashMix(key, 999);
-          key = HashMix(HashMix(key, rb), gb);
           std::string why;
-          if (solver_.AirAssemblyPossible(m.step, mh, bh, key, &why)) out = 1;
+          if (solver_.AirAssemblyPossible(m.step, mh, bh, CheapAssembleKey(m.step, -1, mh, bh),
+                                          &why)) {
+            out = 1;
+          }
           break;  // one LP family per moved grasp: the base grasps differ little
         }
       }
@@ -211,7 +210,9 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
   // The abstract graph: states (status of the moved input, status of the base); edges reversed.
   const int NM = b.n_status[0], NB = b.n_status[1];
   const int N = NM * NB;
-  auto held_by = [&](int k, int status) { return status >= b.n_rest[k] ? (status - b.n_rest[k]) / 2 : -1; };
+  auto held_by = [&](int k, int status) {
+    return status >= b.n_rest[k] ? (status - b.n_rest[k]) / 2 : -1;
+  };
   std::vector<std::vector<int>> reverse(N);
   std::vector<int> goal_cost(N, kFar);
   for (int sm = 0; sm < NM; ++sm) {
@@ -253,7 +254,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
         if (rb >= 0) {
           if ((sb - b.n_rest[1]) % 2 == 1 && air_asm[rm * R + rb]) goal_cost[from] = 1;
         } else if (sb > 0 || b.loc0[1] >= 0) {
-          const int ra = rest_asm[static_cast<size_t>(sb) * R + rm];
+          const int ra = asm_at(sb, rm);
           if (ra > 0) goal_cost[from] = ra;
         }
       }
@@ -277,7 +278,6 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
       }
     }
   }
-  b.valid = true;
 
   // Why the assembly is out of reach from the start, in words.
   const int start = BackwardDistance(s0);
@@ -291,7 +291,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
         ++n_all;
         n_asm += AssemblyGrasp(0, r, g) ? 1 : 0;
       }
-      for (int i = 0; i < b.n_rest[1]; ++i) base_support |= rest_asm[static_cast<size_t>(i) * R + r] > 0;
+      for (int i = 0; i < b.n_rest[1]; ++i) base_support |= asm_at(i, r) > 0;
       for (int q = 0; q < R; ++q) base_support |= air_asm[r * R + q] != 0;
       m_pick |= pick[0][idx_pick(0, r, 0)] || pick[0][idx_pick(0, r, 1)];
     }
@@ -331,7 +331,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
     std::fprintf(stderr, "[bwd] rest_asm:");
     for (int i = 0; i < b.n_rest[1]; ++i) {
       std::fprintf(stderr, " [");
-      for (int r = 0; r < R; ++r) std::fprintf(stderr, "%d", rest_asm[static_cast<size_t>(i) * R + r]);
+      for (int r = 0; r < R; ++r) std::fprintf(stderr, "%d", asm_at(i, r));
       std::fprintf(stderr, "]");
     }
     std::fprintf(stderr, " air_asm:");

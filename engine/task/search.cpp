@@ -288,11 +288,7 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
     if (s.held[r] == m.base) bh.push_back({r, s.grasp[r]});
   }
   const bool b_rests = s.loc[m.base] >= 0;
-  std::uint64_t key = HashMix(103, m.step);
-  key = HashMix(key, b_rests ? static_cast<std::uint64_t>(s.loc[m.base]) + 7 : 3);
-  for (const auto& [r, g] : mh) key = HashMix(HashMix(key, r), g);
-  key = HashMix(key, 999);
-  for (const auto& [r, g] : bh) key = HashMix(HashMix(key, r), g);
+  const std::uint64_t key = CheapAssembleKey(m.step, b_rests ? s.loc[m.base] : -1, mh, bh);
   if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(key, it->second);
   bool ok = true;
   std::string why;

@@ -118,7 +118,6 @@ class TaskSearch {
 
   /// The backward abstraction of the current milestone (backward.cpp).
   struct Backward {
-    bool valid = false;
     int step = -1, moved = -1, base = -1;
     int loc0[2] = {-1, -1};    ///< Start location of each input (-1: held).
     int n_place[2] = {0, 0};   ///< Placements of each input in the abstraction.

@@ -108,4 +108,12 @@ inline std::uint64_t AssemblyLpKey(int step, int base_loc,
   return key;
 }
 
+/// Cache key of the search's cheap assembly check of `step` (the base resting at `base_loc`, or
+/// in the air when -1) with those holders; the in-air check hands it on to the LP cache.
+inline std::uint64_t CheapAssembleKey(int step, int base_loc,
+                                      const std::vector<std::pair<int, int>>& moved_holders,
+                                      const std::vector<std::pair<int, int>>& base_holders) {
+  return HashMix(103, AssemblyLpKey(step, base_loc, moved_holders, base_holders));
+}
+
 }  // namespace wrap
