@@ -91,8 +91,17 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   plan->add_option("--force-scale", plan_args.force_scale,
                    "Scale lambda on the mating force and torque (default 1)");
   plan->add_option("--planner", plan_args.planner,
-                   "Planner variant: counting (Milestones + counting; default), wrap (backward "
-                   "abstract heuristic), exact (wrap with weight-one A* fills)");
+                   "Planner variant (the paper's comparison rows): wrap (default: backward "
+                   "abstract heuristic), optimistic (assembly grasps chosen first), flat (Flat "
+                   "lazy: no milestones), counting (Milestones + counting), exact (wrap with "
+                   "weight-one A* fills), fine (wrap, finer projection)");
+  plan->add_flag("--optimize", plan_args.optimize,
+                 "After the first plan, improve it (large neighbourhood search) until the time "
+                 "limit or until no window of milestones gives a cheaper plan");
+  plan->add_option("--memory-limit", plan_args.memory_limit_mb,
+                   "Memory the search may hold, in MiB (default 4096); beyond it the run stops "
+                   "with \"out of memory\"")
+      ->check(CLI::PositiveNumber);
   plan->add_option("--grasps", plan_args.grasps, "Grasp-set size (default: the project's)")
       ->check(CLI::PositiveNumber);
   plan->add_flag("--validate", plan_args.validate,

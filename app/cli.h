@@ -56,7 +56,9 @@ struct PlanArgs {
   std::optional<double> time_limit;   ///< --time-limit [s]; absent: the project's.
   std::string wrench = "full";        ///< --wrench full|gravity|none.
   double force_scale = 1.0;           ///< --force-scale lambda.
-  std::string planner = "counting";   ///< --planner variant.
+  std::string planner = "wrap";       ///< --planner variant.
+  bool optimize = false;              ///< --optimize: improve the plan until the time limit.
+  long long memory_limit_mb = 4096;   ///< --memory-limit [MiB].
   int grasps = 0;                     ///< --grasps; 0: the project's planner.grasps.
   bool validate = false;              ///< --validate with the independent validator.
   bool task_only = false;             ///< --task-only.

@@ -40,6 +40,8 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   TaskPlannerOptions options;
   options.project_file = args.project;
   options.planner = args.planner;
+  options.optimize = args.optimize;
+  options.memory_limit_mb = args.memory_limit_mb;
   if (args.wrench == "full") {
     options.wrench_mode = MatingWrenchMode::kFull;
   } else if (args.wrench == "gravity") {
@@ -93,6 +95,11 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   const PlanStats& st = plan->stats;
   out << "Preprocessing (t_grasp) " << Fmt("%.2f", st.t_grasp_s) << " s\n";
   if (st.solved) {
+    if (args.optimize) {
+      out << "Improved: cost " << st.first_cost << " -> " << st.cost << " in "
+          << Fmt("%.2f", st.t_opt_s) << " s (" << st.cost_history.size() - 1
+          << " improvements)\n";
+    }
     out << "Solved: cost " << st.cost << ", time to first plan " << Fmt("%.2f", st.t_init_s)
         << " s (t_fwd " << Fmt("%.2f", st.t_fwd_s) << ", t_ik " << Fmt("%.2f", st.t_ik_s)
         << ", t_lp " << Fmt("%.2f", st.t_lp_s) << "; " << st.expansions << " nodes, "

@@ -5,7 +5,10 @@
 // its stable placements anywhere on the table: slot and yaw are projected away) or held by one
 // robot with a grasp of one of two classes: "assembly grasps" leave the gripper clear of the other
 // input at the mating pose, the others do not. Everything else of the forward state (the exact
-// grasp, slot and yaw, the other robots' objects) is projected away.
+// grasp, slot and yaw, the other robots' objects) is projected away. The "fine" variant keeps
+// more of the grasp: its class is also the gripper's approach direction in the object's frame
+// (one of six), so the abstraction sees, for instance, that two grippers coming from the same
+// side cannot hand over and that a grasp from below cannot set an object down.
 //
 // Abstract actions. pick and place (some grasp of the class clears the table in that placement;
 // from the start location the search's own cheap pick check), handover (some pair of grasps of
@@ -43,6 +46,17 @@ bool TaskSearch::AssemblyGrasp(int input, int robot, int grasp) {
   return ok;
 }
 
+int TaskSearch::GraspClass(int input, int robot, int grasp) {
+  const int assembly = AssemblyGrasp(input, robot, grasp) ? 1 : 0;
+  if (!fine_) return assembly;
+  // Fine: the approach axis of the gripper in the object's frame, one of six directions.
+  const GraspRef& g = tables_.grasp(grasp);
+  const Vec3 z = (world_.X_AP[g.part] * g.X_PG).linear().col(2);
+  int axis = 0;
+  z.cwiseAbs().maxCoeff(&axis);
+  return assembly + 2 * (2 * axis + (z[axis] < 0.0 ? 1 : 0));
+}
+
 void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const SymState& s0) {
   Backward& b = backward_;
   b = Backward{};
@@ -52,6 +66,8 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
   const int nodes[2] = {m.moved, m.base};
   const TableSlots& slots = world_.pre->table_slots;
   const int R = n_robots_;
+  const int nc = fine_ ? 12 : 2;  // grasp classes (assembly or not; fine: times 6 directions)
+  b.classes = nc;
 
   // Rest statuses: 0 = the start location, 1 + p = placement p.
   std::vector<std::vector<Iso3>> rest_pose(2);
@@ -62,7 +78,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
                        ? 0
                        : std::min<int>(res.placements, static_cast<int>(placements.size()));
     b.n_rest[k] = 1 + b.n_place[k];
-    b.n_status[k] = b.n_rest[k] + 2 * R;
+    b.n_status[k] = b.n_rest[k] + nc * R;
     rest_pose[k].push_back(b.loc0[k] >= 0 ? tables_.location(b.loc0[k]).X_WA : Iso3::Identity());
     for (int p = 0; p < b.n_place[k]; ++p) {
       rest_pose[k].push_back(PlacementPose(slots.slots[0], 0.0, placements[p]));
@@ -89,13 +105,13 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
 
   // pick[k][i][r][c] (also place for i > 0): some grasp of class c of robot r takes input k
   // from rest status i.
-  auto idx_pick = [&](int i, int r, int c) { return ((i * R) + r) * 2 + c; };
+  auto idx_pick = [&](int i, int r, int c) { return ((i * R) + r) * nc + c; };
   std::vector<char> pick[2];
   for (int k = 0; k < 2; ++k) {
-    pick[k].assign(static_cast<size_t>(b.n_rest[k]) * R * 2, 0);
+    pick[k].assign(static_cast<size_t>(b.n_rest[k]) * R * nc, 0);
     for (int r = 0; r < R; ++r) {
       for (int g : grasps(k, r)) {
-        const int c = AssemblyGrasp(k, r, g) ? 1 : 0;
+        const int c = GraspClass(k, r, g);
         if (b.loc0[k] >= 0 && !pick[k][idx_pick(0, r, c)] &&
             CheapPick(r, nodes[k], b.loc0[k], g)) {
           pick[k][idx_pick(0, r, c)] = 1;
@@ -115,26 +131,29 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
   }
   // hand[k][(r1, c1), (r2, c2)]: some grasps of the two classes lie apart. The answer depends on
   // the two robots' grasp sets only: computed once per pair of sets.
-  auto idx_hand = [&](int r1, int c1, int r2, int c2) { return ((r1 * 2 + c1) * R + r2) * 2 + c2; };
+  auto idx_hand = [&](int r1, int c1, int r2, int c2) {
+    return ((r1 * nc + c1) * R + r2) * nc + c2;
+  };
   std::vector<char> hand[2];
   for (int k = 0; k < 2; ++k) {
-    hand[k].assign(static_cast<size_t>(4 * R * R), 0);
-    std::map<std::pair<int, int>, std::array<char, 4>> by_sets;
+    hand[k].assign(static_cast<size_t>(nc * nc * R * R), 0);
+    std::map<std::pair<int, int>, std::vector<char>> by_sets;
     for (int r1 = 0; r1 < R; ++r1) {
       for (int r2 = 0; r2 < R; ++r2) {
         if (r1 == r2) continue;
-        auto [it, fresh] = by_sets.try_emplace(
-            {world_.robots[r1].grasp_set, world_.robots[r2].grasp_set}, std::array<char, 4>{});
-        std::array<char, 4>& apart = it->second;
+        auto [it, fresh] =
+            by_sets.try_emplace({world_.robots[r1].grasp_set, world_.robots[r2].grasp_set},
+                                std::vector<char>(static_cast<size_t>(nc * nc), 0));
+        std::vector<char>& apart = it->second;
         for (int g1 : grasps(k, r1)) {
           if (!fresh) break;
-          const int c1 = AssemblyGrasp(k, r1, g1) ? 1 : 0;
+          const int c1 = GraspClass(k, r1, g1);
           for (int g2 : grasps(k, r2)) {
-            const int c2 = AssemblyGrasp(k, r2, g2) ? 1 : 0;
-            if (!apart[c1 * 2 + c2] && GraspsApart(g1, g2)) apart[c1 * 2 + c2] = 1;
+            const int c2 = GraspClass(k, r2, g2);
+            if (!apart[c1 * nc + c2] && GraspsApart(g1, g2)) apart[c1 * nc + c2] = 1;
           }
         }
-        for (int c = 0; c < 4; ++c) hand[k][idx_hand(r1, c / 2, r2, c % 2)] = apart[c];
+        for (int c = 0; c < nc * nc; ++c) hand[k][idx_hand(r1, c / nc, r2, c % nc)] = apart[c];
       }
     }
   }
@@ -211,7 +230,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
   const int NM = b.n_status[0], NB = b.n_status[1];
   const int N = NM * NB;
   auto held_by = [&](int k, int status) {
-    return status >= b.n_rest[k] ? (status - b.n_rest[k]) / 2 : -1;
+    return status >= b.n_rest[k] ? (status - b.n_rest[k]) / nc : -1;
   };
   std::vector<std::vector<int>> reverse(N);
   std::vector<int> goal_cost(N, kFar);
@@ -232,27 +251,27 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
           if (s == 0 && b.loc0[k] < 0) continue;
           for (int r = 0; r < R; ++r) {
             if (r == other_holder) continue;
-            for (int c = 0; c < 2; ++c) {
-              if (pick[k][idx_pick(s, r, c)]) add(b.n_rest[k] + 2 * r + c);
+            for (int c = 0; c < nc; ++c) {
+              if (pick[k][idx_pick(s, r, c)]) add(b.n_rest[k] + nc * r + c);
             }
           }
         } else {
-          const int r = (s - b.n_rest[k]) / 2, c = (s - b.n_rest[k]) % 2;
+          const int r = (s - b.n_rest[k]) / nc, c = (s - b.n_rest[k]) % nc;
           for (int p = 0; p < b.n_place[k]; ++p) {
             if (pick[k][idx_pick(1 + p, r, c)]) add(1 + p);
           }
           for (int r2 = 0; r2 < R; ++r2) {
             if (r2 == r || r2 == other_holder) continue;
-            for (int c2 = 0; c2 < 2; ++c2) {
-              if (hand[k][idx_hand(r, c, r2, c2)]) add(b.n_rest[k] + 2 * r2 + c2);
+            for (int c2 = 0; c2 < nc; ++c2) {
+              if (hand[k][idx_hand(r, c, r2, c2)]) add(b.n_rest[k] + nc * r2 + c2);
             }
           }
         }
       }
       // Assemble: the moved input held with an assembly grasp.
-      if (rm >= 0 && (sm - b.n_rest[0]) % 2 == 1) {
+      if (rm >= 0 && (sm - b.n_rest[0]) % nc % 2 == 1) {
         if (rb >= 0) {
-          if ((sb - b.n_rest[1]) % 2 == 1 && air_asm[rm * R + rb]) goal_cost[from] = 1;
+          if ((sb - b.n_rest[1]) % nc % 2 == 1 && air_asm[rm * R + rb]) goal_cost[from] = 1;
         } else if (sb > 0 || b.loc0[1] >= 0) {
           const int ra = asm_at(sb, rm);
           if (ra > 0) goal_cost[from] = ra;
@@ -293,7 +312,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
       }
       for (int i = 0; i < b.n_rest[1]; ++i) base_support |= asm_at(i, r) > 0;
       for (int q = 0; q < R; ++q) base_support |= air_asm[r * R + q] != 0;
-      m_pick |= pick[0][idx_pick(0, r, 0)] || pick[0][idx_pick(0, r, 1)];
+      for (int c = 0; c < nc; ++c) m_pick |= pick[0][idx_pick(0, r, c)] != 0;
     }
     if (n_all == 0) {
       b.why = "no robot has a grasp of '" + mn + "'";
@@ -323,8 +342,9 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
           ++n;
           n_asm += AssemblyGrasp(k, r, g) ? 1 : 0;
         }
-        std::fprintf(stderr, "r%d %d/%d asm, pick0 %d%d; ", r, n_asm, n,
-                     pick[k][idx_pick(0, r, 0)], pick[k][idx_pick(0, r, 1)]);
+        int n_pick = 0;
+        for (int c = 0; c < nc; ++c) n_pick += pick[k][idx_pick(0, r, c)];
+        std::fprintf(stderr, "r%d %d/%d asm, pick0 %d classes; ", r, n_asm, n, n_pick);
       }
       std::fprintf(stderr, "\n");
     }
@@ -343,28 +363,29 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
 int TaskSearch::BackwardDistance(const SymState& s) {
   const Backward& b = backward_;
   const int nodes[2] = {b.moved, b.base};
-  int status[2];
+  // Each input's statuses: resting (one), or held (one per holder: the nearest counts).
+  int status[2][2] = {{-1, -1}, {-1, -1}};
   for (int k = 0; k < 2; ++k) {
     const int node = nodes[k];
     const int16_t loc = s.loc[node];
     if (loc >= 0) {
       const int p = loc == b.loc0[k] ? -1 : tables_.location(loc).placement.placement;
-      status[k] = p >= 0 && p < b.n_place[k] ? 1 + p : 0;
+      status[k][0] = p >= 0 && p < b.n_place[k] ? 1 + p : 0;
       continue;
     }
-    int holder = -1, cls = 0;
-    for (int r = 0; r < n_robots_; ++r) {
-      if (s.held[r] != node) continue;
-      const int c = AssemblyGrasp(k, r, s.grasp[r]) ? 1 : 0;
-      if (holder < 0 || c > cls) {
-        holder = r;
-        cls = c;
-      }
+    int n = 0;
+    for (int r = 0; r < n_robots_ && n < 2; ++r) {
+      if (s.held[r] == node) status[k][n++] = b.n_rest[k] + b.classes * r + GraspClass(k, r, s.grasp[r]);
     }
-    if (holder < 0) return kFar;
-    status[k] = b.n_rest[k] + 2 * holder + cls;
+    if (n == 0) return kFar;
   }
-  return b.dist[status[0] * b.n_status[1] + status[1]];
+  int best = kFar;
+  for (int sm : status[0]) {
+    for (int sb : status[1]) {
+      if (sm >= 0 && sb >= 0) best = std::min(best, b.dist[sm * b.n_status[1] + sb]);
+    }
+  }
+  return best;
 }
 
 }  // namespace wrap

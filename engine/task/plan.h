@@ -35,6 +35,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/pose.h"
@@ -134,6 +135,12 @@ struct PlanStats {
   int milestones = 0;           ///< Milestones (assembly steps) planned.
   int backtracks = 0;           ///< Milestones re-planned after a later one failed.
   int widenings = 0;            ///< Grasp and placement subsets widened.
+  bool out_of_memory = false;   ///< Stopped at the memory limit (failure says so).
+  int first_cost = 0;           ///< Cost of the first plan (before --optimize).
+  double t_opt_s = 0.0;         ///< Plan improvement (--optimize) [s].
+  /// Cost over time (--optimize): (seconds since planning started, cost) at the first plan
+  /// and at every improvement.
+  std::vector<std::pair<double, int>> cost_history;
   std::string failure;          ///< Empty when solved, else why not, in words.
 };
 

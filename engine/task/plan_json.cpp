@@ -53,6 +53,13 @@ ojson KeyframeJson(const Plan& plan, const Keyframe& k) {
   return ojson{{"q", q}, {"objects", objects}};
 }
 
+// [[seconds, cost], ...]
+ojson CostHistoryJson(const std::vector<std::pair<double, int>>& history) {
+  ojson out = ojson::array();
+  for (const auto& [t, cost] : history) out.push_back(ojson::array({t, cost}));
+  return out;
+}
+
 ojson StatsJson(const PlanStats& s) {
   return ojson{{"solved", s.solved},
                {"cost", s.cost},
@@ -77,6 +84,10 @@ ojson StatsJson(const PlanStats& s) {
                {"milestones", s.milestones},
                {"backtracks", s.backtracks},
                {"widenings", s.widenings},
+               {"out_of_memory", s.out_of_memory},
+               {"first_cost", s.first_cost},
+               {"t_opt_s", s.t_opt_s},
+               {"cost_history", CostHistoryJson(s.cost_history)},
                {"failure", s.failure}};
 }
 
@@ -498,7 +509,8 @@ PlanStats ReadStats(const json& root, const std::string& at) {
                     "t_fwd_s",    "t_ik_s",        "wrench_mode", "force_scale",
                     "grasps",     "expansions",    "validations", "validation_failures",
                     "lp_checks",  "lp_cache_hits", "ik_calls",    "collision_checks",
-                    "milestones", "backtracks",    "widenings",   "failure"});
+                    "milestones", "backtracks",    "widenings",   "out_of_memory",
+                    "first_cost", "t_opt_s",       "cost_history", "failure"});
   PlanStats s;
   // Required: what DESIGN.md promises every plan file holds.
   s.solved = Bool(j, at, "solved");
@@ -540,6 +552,21 @@ PlanStats ReadStats(const json& root, const std::string& at) {
   small("milestones", s.milestones);
   small("backtracks", s.backtracks);
   small("widenings", s.widenings);
+  if (Find(j, "out_of_memory")) s.out_of_memory = Bool(j, at, "out_of_memory");
+  small("first_cost", s.first_cost);
+  time("t_opt_s", s.t_opt_s);
+  if (const json* history = Find(j, "cost_history")) {
+    const std::string path = Join(at, "cost_history");
+    ExpectArray(*history, path);
+    for (size_t i = 0; i < history->size(); ++i) {
+      const std::string item = path + "[" + std::to_string(i) + "]";
+      const json& e = ExpectArray((*history)[i], item);
+      if (e.size() != 2) Bad(item, "expected [seconds, cost]");
+      const double t = NumberValue(e[0], item + "[0]");
+      if (t < 0.0) Bad(item + "[0]", "expected seconds >= 0");
+      s.cost_history.push_back({t, static_cast<int>(IntegerValue(e[1], item + "[1]", 0, INT_MAX))});
+    }
+  }
   if (Find(j, "failure")) s.failure = String(j, at, "failure");
   return s;
 }

@@ -26,20 +26,96 @@ std::string ModeName(MatingWrenchMode mode) {
   return "?";
 }
 
+int CostOf(const std::vector<MilestoneResult>& results, int from, int to) {
+  int cost = 0;
+  for (int j = from; j < to; ++j) cost += static_cast<int>(results[j].actions.size());
+  return cost;
+}
+
+// Plan improvement (paper §IV-D, "anytime"): a large neighbourhood search over the milestones of
+// the incumbent. A window of n milestones is refilled by weight-one A* fills bounded by the
+// window's cost, the milestones after it are refilled by the variant's own fills (or kept, when
+// the window ends in the incumbent's state) bounded so that the whole plan is strictly cheaper;
+// a cheaper plan replaces the incumbent. n grows from 1 to the whole horizon; the search stops
+// early at the time limit or on cancellation. Returns false when it was stopped.
+bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& s0,
+             const ContState& c0, std::vector<MilestoneResult>& incumbent, RunContext& ctx,
+             const Clock::time_point start, std::vector<std::pair<double, int>>& history) {
+  const int K = static_cast<int>(order.size());
+  int cost = CostOf(incumbent, 0, K);
+  const bool debug = std::getenv("WRAP_TASK_DEBUG") != nullptr;
+  for (int n = 1; n <= K; ++n) {
+    for (int i = 0; i + n <= K; ++i) {
+      if (ctx.ShouldStop()) return false;
+      const int window_cost = CostOf(incumbent, i, i + n);
+      const int budget = cost - CostOf(incumbent, 0, i) - 1;  // the rest, strictly cheaper
+      std::vector<MilestoneResult> candidate(incumbent.begin(), incumbent.begin() + i);
+      SymState s = i == 0 ? s0 : incumbent[i - 1].end;
+      ContState c = i == 0 ? c0 : incumbent[i - 1].end_c;
+      int running = 0;
+      bool ok = true;
+      for (int j = i; j < K && ok; ++j) {
+        if (j >= i + n && s == incumbent[j - 1].end &&
+            c.Fingerprint(s) == incumbent[j - 1].end_c.Fingerprint(s)) {
+          // The window ends where the incumbent's did: the rest holds as it is.
+          for (int t = j; t < K; ++t) candidate.push_back(incumbent[t]);
+          running += CostOf(incumbent, j, K);
+          break;
+        }
+        FillLimits limits;
+        limits.max_cost = budget - running - (K - j - 1);  // later milestones take >= 1 each
+        if (j < i + n) {
+          limits.weight = 1;
+          limits.max_cost = std::min(limits.max_cost, window_cost - running - (i + n - j - 1));
+        }
+        if (limits.max_cost < 1) {
+          ok = false;
+          break;
+        }
+        MilestoneResult r =
+            search.Fill(j, order[j], j + 1 < K ? order[j + 1] : -1, s, c, {}, limits);
+        if (r.stopped || r.out_of_memory) return false;
+        if (!r.ok) {
+          ok = false;
+          break;
+        }
+        running += static_cast<int>(r.actions.size());
+        s = r.end;
+        c = r.end_c;
+        candidate.push_back(std::move(r));
+      }
+      if (ok && static_cast<int>(candidate.size()) == K && CostOf(candidate, 0, K) < cost) {
+        incumbent = std::move(candidate);
+        cost = CostOf(incumbent, 0, K);
+        const double t = std::chrono::duration<double>(Clock::now() - start).count();
+        history.push_back({t, cost});
+        if (debug) {
+          std::fprintf(stderr, "[opt] window %d+%d: cost %d at %.2f s\n", i, n, cost, t);
+        }
+      }
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const Preprocessed& pre,
                       const TaskPlannerOptions& options, RunContext& ctx) {
   const auto start = Clock::now();
-  if (options.planner != "counting" && options.planner != "wrap" && options.planner != "exact") {
+  static const std::set<std::string> kVariants = {"wrap",  "optimistic", "flat",
+                                                   "counting", "exact", "fine"};
+  if (!kVariants.contains(options.planner)) {
     return Fail(ErrorCode::kInvalidInput,
-                "planner: unknown variant '" + options.planner + "' (known: wrap, exact, counting)");
+                "planner: unknown variant '" + options.planner +
+                    "' (known: wrap, optimistic, flat, counting, exact, fine)");
   }
   if (!(options.force_scale >= 0.0) || !std::isfinite(options.force_scale)) {
     return Fail(ErrorCode::kInvalidInput, "planner: --force-scale must be finite and >= 0");
   }
   if (options.max_effort < 0 || options.max_effort > 2 || options.max_holders < 1 ||
-      options.max_nodes < 100 || !(options.min_clearance_m >= 0.0)) {
+      options.max_nodes < 100 || !(options.min_clearance_m >= 0.0) ||
+      options.memory_limit_mb < 1) {
     return Fail(ErrorCode::kInvalidInput, "planner: options out of range");
   }
   auto world_or = BuildTaskWorld(project, check, pre, options.project_file);
@@ -79,39 +155,52 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   plan.initial.q = c0.q;
   for (int p = 0; p < world.num_parts; ++p) plan.initial.objects.push_back({p, c0.X_WA[p], true});
 
-  // Milestones in the DAG's topological order, with backtracking.
+  // Milestones in the DAG's topological order, with backtracking; Flat lazy: one search.
   const std::vector<int>& order = world.tree->step_order;
   plan.milestone_steps = order;
   const int K = static_cast<int>(order.size());
-  std::vector<MilestoneResult> results(K);
+  const bool flat = options.planner == "flat";
+  std::vector<MilestoneResult> results(flat ? 1 : K);
   std::vector<std::set<std::uint64_t>> excluded(K);
   int k = 0;
   int backtracks = 0;
   std::string failure;
   bool stopped = false;
+  bool out_of_memory = false;
   while (k < K) {
-    ctx.Progress("task", static_cast<double>(k) / std::max(1, K),
-                 "milestone " + std::to_string(k + 1) + "/" + std::to_string(K) + " '" +
-                     world.tree->nodes[order[k]].name + "'");
+    const std::string words = flat ? "the whole task (flat)"
+                                   : "milestone " + std::to_string(k + 1) + "/" +
+                                         std::to_string(K) + " '" +
+                                         world.tree->nodes[order[k]].name + "'";
+    ctx.Progress("task", static_cast<double>(k) / std::max(1, K), words);
     const SymState& s = k == 0 ? s0 : results[k - 1].end;
     const ContState& c = k == 0 ? c0 : results[k - 1].end_c;
-    MilestoneResult r =
-        search.Fill(k, order[k], k + 1 < K ? order[k + 1] : -1, s, c, excluded[k]);
+    MilestoneResult r = flat ? search.FillFlat(s0, c0)
+                             : search.Fill(k, order[k], k + 1 < K ? order[k + 1] : -1, s, c,
+                                           excluded[k]);
     if (r.ok) {
+      if (flat) {
+        results[0] = std::move(r);
+        k = K;
+        break;
+      }
       results[k] = std::move(r);
       ++k;
       continue;
     }
-    if (r.stopped) {
-      stopped = true;
-      failure = "milestone " + std::to_string(k + 1) + "/" + std::to_string(K) + " '" +
-                world.tree->nodes[order[k]].name + "' was being planned; checks that failed most: " +
-                r.failure;
+    if (r.stopped || r.out_of_memory) {
+      stopped = r.stopped;
+      out_of_memory = r.out_of_memory;
+      failure = words + " was being planned; checks that failed most: " + r.failure;
+      if (out_of_memory) {
+        failure = "out of memory (the search held more than the " +
+                  std::to_string(options.memory_limit_mb) + " MiB limit) while " + failure;
+      }
       break;
     }
     failure = r.failure;
     if (std::getenv("WRAP_TASK_DEBUG")) std::fprintf(stderr, "[task] %s\n", failure.c_str());
-    if (k > 0 && backtracks < options.max_backtracks) {
+    if (!flat && k > 0 && backtracks < options.max_backtracks) {
       excluded[k - 1].insert(results[k - 1].end.Hash());
       excluded[k].clear();
       --k;
@@ -119,6 +208,16 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
       continue;
     }
     break;
+  }
+  const double t_first = std::chrono::duration<double>(Clock::now() - start).count();
+  std::vector<std::pair<double, int>> history;
+  double t_opt = 0.0;
+  if (k == K) {
+    history.push_back({t_first, CostOf(results, 0, static_cast<int>(results.size()))});
+    if (options.optimize && !flat) {
+      Improve(search, order, s0, c0, results, ctx, start, history);
+      t_opt = std::chrono::duration<double>(Clock::now() - start).count() - t_first;
+    }
   }
   if (ctx.cancelled()) return Fail(ErrorCode::kCancelled, "planner: cancelled");
 
@@ -148,18 +247,32 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   ctx.AddTime("lp", st.t_lp_s);
   ctx.AddTime("fwd", st.t_fwd_s);
   ctx.AddTime("bwd", st.t_bwd_s);
-  st.t_init_s = std::chrono::duration<double>(Clock::now() - start).count();
+  st.t_init_s = t_first;
+  st.t_opt_s = t_opt;
+  st.cost_history = history;
+  st.out_of_memory = out_of_memory;
   if (k == K) {
     st.solved = true;
     for (const MilestoneResult& r : results) {
       plan.actions.insert(plan.actions.end(), r.actions.begin(), r.actions.end());
     }
+    if (flat) {
+      // Milestones after the fact: the steps in the order the search assembled them.
+      plan.milestone_steps.clear();
+      for (PlanAction& a : plan.actions) {
+        a.milestone = static_cast<int>(plan.milestone_steps.size());
+        if (a.type == ActionType::kAssemble) plan.milestone_steps.push_back(a.objects.back());
+      }
+      for (PlanAction& a : plan.actions) a.milestone = std::min(a.milestone, K - 1);
+    }
     st.cost = static_cast<int>(plan.actions.size());
+    st.first_cost = history.front().second;
   } else {
     st.solved = false;
     if (stopped) {
       failure = (ctx.timed_out() ? "time limit reached while " : "stopped while ") + failure;
     }
+    if (failure.empty()) failure = "no plan";
     st.failure = failure;
   }
   return plan;

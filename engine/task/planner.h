@@ -10,7 +10,7 @@
 // revisited at the next; grasp and placement subsets are widened when a milestone fails; a
 // milestone that fails makes the previous one look for another end state (backtracking).
 //
-// "wrap" replaces the counting heuristic by WRAP's backward abstract heuristic (search.h,
+// "wrap" (the default) replaces the counting heuristic by WRAP's backward abstract heuristic (search.h,
 // backward.cpp): per milestone a breadth-first search backwards from the assembly over the two
 // inputs' projected status (resting where they start or in a placement; held by a robot with an
 // assembly grasp or another one); "exact" is the paper's "exact fills": the same with f = g + h
@@ -32,8 +32,17 @@ namespace wrap {
 
 /// Options of PlanTask.
 struct TaskPlannerOptions {
-  std::string planner = "counting";  ///< Variant: "counting" (Milestones + counting), "wrap"
-                                     ///< (backward abstract heuristic), "exact" (wrap, weight 1).
+  /// Variant, the paper's comparison rows: "wrap" (backward abstract heuristic), "optimistic"
+  /// (assembly grasps chosen first, like Dogar et al.), "flat" (Flat lazy: one search, no
+  /// milestones), "counting" (Milestones + counting), "exact" (wrap with weight-one fills),
+  /// "fine" (wrap with a finer projection: grasp classes split by approach direction).
+  std::string planner = "wrap";
+  /// Anytime plan improvement after the first plan (large neighbourhood search) until the time
+  /// limit of the RunContext or until windows of the whole horizon bring nothing more.
+  bool optimize = false;
+  /// Memory the search may hold (nodes, queues, caches; estimated) [MiB]; beyond it the run
+  /// stops with "out of memory" in stats.failure.
+  long long memory_limit_mb = 4096;
   MatingWrenchMode wrench_mode = MatingWrenchMode::kFull;  ///< full, gravity or none.
   double force_scale = 1.0;      ///< Lambda on the mating force and torque, >= 0.
   double min_clearance_m = 0.005;  ///< Least distance between two robots at a keyframe [m].

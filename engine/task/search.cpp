@@ -25,6 +25,8 @@ constexpr long long kLocalNodes = 20000;
 constexpr int kRootFailures = 15;
 // Most actions in one milestone's plan: longer candidates count as dead ends.
 constexpr int kMaxMilestoneActions = 16;
+// Optimistic: permanent failures of the target's assembly before the next target.
+constexpr int kTargetFailures = 3;
 // Validation failures in one round (resolution and effort level) before moving to the next.
 constexpr int kRoundFailures = 400;
 
@@ -82,8 +84,47 @@ TaskSearch::TaskSearch(const TaskWorld& world, TaskTables& tables, KeyframeSolve
       seed_(seed),
       widen_(widen),
       n_robots_(static_cast<int>(world.robots.size())),
-      use_backward_(options.planner == "wrap" || options.planner == "exact"),
-      weight_(options.planner == "exact" ? 1 : 2) {}
+      use_backward_(options.planner == "wrap" || options.planner == "exact" ||
+                    options.planner == "fine"),
+      default_weight_(options.planner == "exact" ? 1 : 2),
+      weight_(default_weight_),
+      fine_(options.planner == "fine"),
+      flat_(options.planner == "flat"),
+      optimistic_(options.planner == "optimistic"),
+      flat_order_(world.tree->step_order) {}
+
+TaskSearch::Milestone TaskSearch::StepMilestone(int step, int next_step) const {
+  Milestone m;
+  m.step = step;
+  m.moved = world_.interface(step).moved;
+  m.base = world_.interface(step).base;
+  m.final = next_step < 0;
+  // Objects robots may still hold at the end: the inputs of the next step (none at the end).
+  if (next_step >= 0) {
+    m.keep[0] = world_.interface(next_step).moved;
+    m.keep[1] = world_.interface(next_step).base;
+  }
+  return m;
+}
+
+void TaskSearch::SetClasses(const Milestone& m) {
+  if (backward_.step == m.step) return;
+  backward_ = Backward{};
+  backward_.step = m.step;
+  backward_.moved = m.moved;
+  backward_.base = m.base;
+}
+
+std::size_t TaskSearch::MemoryBytes(std::size_t open, std::size_t closed) const {
+  // A node: the struct, its state's three vectors (heap blocks with their headers).
+  const std::size_t state = static_cast<std::size_t>(world_.num_nodes) * 2 +
+                            static_cast<std::size_t>(n_robots_) * 6 + 3 * 32;
+  std::size_t bytes = nodes_.capacity() * (sizeof(Node) + state);
+  bytes += open * 48 + closed * 48;  // the queue's entries, the hash map's
+  // Caches that live across searches: witnesses hold keyframes (joint vectors, poses).
+  bytes += witnesses_.size() * 2048 + cheap_.size() * 96 + failed_level_.size() * 48;
+  return bytes;
+}
 
 TaskSearch::Resolution TaskSearch::ResolutionAt(int level) const {
   constexpr int kGrasps[] = {6, 12, 1 << 20};
@@ -129,6 +170,18 @@ bool TaskSearch::GraspsApart(int grasp_a, int grasp_b) const {
 
 int TaskSearch::Heuristic(const SymState& s, const Milestone& m) {
   int h = 0;
+  if (m.flat) {
+    // Flat lazy: per step not yet assembled the assembly and, when its moved input exists but
+    // is not in a hand, a pick; a release per robot holding something.
+    for (int step : flat_order_) {
+      if (s.loc[step] != kInactive) continue;
+      h += 1;
+      const int moved = world_.interface(step).moved;
+      if (s.loc[moved] >= 0) h += 1;
+    }
+    for (int r = 0; r < n_robots_; ++r) h += s.held[r] >= 0 ? 1 : 0;
+    return h;
+  }
   const bool done = s.loc[m.step] != kInactive;
   if (use_backward_ && !done) {
     // WRAP: the abstract distance to the assembly, the releases of other objects, and the
@@ -151,12 +204,31 @@ int TaskSearch::Heuristic(const SymState& s, const Milestone& m) {
     if (s.held[r] >= 0 && s.held[r] != m.keep[0] && s.held[r] != m.keep[1]) h += 1;
   }
   if (m.final && m_needs_grasp) h += 1;
+  // Optimistic: the moved input in another hand or grasp than the target's needs a handover.
+  if (!done && target_.rm >= 0 && !m_needs_grasp &&
+      !(s.held[target_.rm] == m.moved && s.grasp[target_.rm] == target_.gm)) {
+    h += 1;
+  }
   return h;
+}
+
+bool TaskSearch::TargetAllows(const SymState& s, const Milestone& m) const {
+  if (target_.rm < 0) return true;
+  if (s.held[target_.rm] != m.moved || s.grasp[target_.rm] != target_.gm) return false;
+  if (target_.base_rests != (s.loc[m.base] >= 0)) return false;
+  if (target_.base_moved && s.loc[m.base] == target_start_loc_) return false;
+  return target_.rb < 0 || (s.held[target_.rb] == m.base && s.grasp[target_.rb] == target_.gb);
 }
 
 bool TaskSearch::IsGoal(const SymState& s, const Milestone& m,
                         const std::set<std::uint64_t>& excluded) const {
   if (s.loc[m.step] == kInactive) return false;
+  if (m.flat) {
+    for (int r = 0; r < n_robots_; ++r) {
+      if (s.held[r] >= 0) return false;
+    }
+    return true;
+  }
   for (int r = 0; r < n_robots_; ++r) {
     if (s.held[r] >= 0 && s.held[r] != m.keep[0] && s.held[r] != m.keep[1]) return false;
   }
@@ -361,8 +433,33 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
   return ok;
 }
 
+void TaskSearch::FlatSuccessors(const SymState& s, const Resolution& res,
+                                std::vector<std::pair<TaskAction, SymState>>& out) {
+  out.clear();
+  std::vector<std::pair<TaskAction, SymState>> some;
+  std::unordered_set<std::uint64_t> seen;  // releases and set-downs come from every step
+  auto add = [&](const Milestone& m) {
+    Successors(s, m, res, some);
+    for (auto& e : some) {
+      if (seen.insert(e.first.Hash()).second) out.push_back(std::move(e));
+    }
+  };
+  for (int step : flat_order_) {
+    if (s.loc[step] != kInactive) continue;
+    const StepInterface& st = world_.interface(step);
+    if (s.loc[st.moved] == kInactive || s.loc[st.base] == kInactive) continue;
+    add(StepMilestone(step, step));
+  }
+  const int product = flat_order_.back();
+  if (s.loc[product] != kInactive) add(StepMilestone(product, -1));
+}
+
 void TaskSearch::Successors(const SymState& s, const Milestone& m, const Resolution& res,
                             std::vector<std::pair<TaskAction, SymState>>& out) {
+  if (m.flat) {
+    FlatSuccessors(s, res, out);
+    return;
+  }
   out.clear();
   const bool done = s.loc[m.step] != kInactive;
   int focus[2] = {-1, -1};
@@ -487,7 +584,8 @@ void TaskSearch::Successors(const SymState& s, const Milestone& m, const Resolut
   }
   // Assemble.
   if (!done && s.loc[m.moved] == kInAir && s.NumHolders(m.moved) >= 1 &&
-      (s.loc[m.base] >= 0 || s.NumHolders(m.base) >= 1) && CheapAssemble(s, m)) {
+      (s.loc[m.base] >= 0 || s.NumHolders(m.base) >= 1) && TargetAllows(s, m) &&
+      CheapAssemble(s, m)) {
     TaskAction a;
     a.type = ActionType::kAssemble;
     a.obj = static_cast<int16_t>(m.step);
@@ -500,18 +598,27 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milesto
                                                const std::set<std::uint64_t>& excluded,
                                                const std::unordered_map<std::uint64_t, bool>& dead_ends,
                                                const std::unordered_set<std::uint64_t>& forbidden,
-                                               long long node_budget, std::vector<int>& path) {
+                                               long long node_budget, int g0, int max_cost,
+                                               std::vector<int>& path) {
   nodes_.clear();
   std::unordered_map<std::uint64_t, int> best_g;
   using Entry = std::tuple<int, int, long long, int>;  // f, -g, sequence, node
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
   long long sequence = 0;
+  const int h0 = Heuristic(s0, m);
+  if (g0 + h0 > max_cost) return SearchStatus::kExhausted;
   nodes_.push_back({s0, 0, -1, {}});
   best_g[s0.Hash()] = 0;
-  open.push({weight_ * Heuristic(s0, m), 0, sequence++, 0});
+  open.push({weight_ * h0, 0, sequence++, 0});
+  const std::size_t memory_limit = static_cast<std::size_t>(options_.memory_limit_mb) << 20;
   std::vector<std::pair<TaskAction, SymState>> successors;
   while (!open.empty()) {
-    if ((++expansions_ & 127) == 0 && ctx_.ShouldStop()) return SearchStatus::kStopped;
+    if ((++expansions_ & 127) == 0) {
+      if (ctx_.ShouldStop()) return SearchStatus::kStopped;
+      if (MemoryBytes(open.size(), best_g.size()) > memory_limit) {
+        return SearchStatus::kOutOfMemory;
+      }
+    }
     const auto [f, neg_g, seq, index] = open.top();
     open.pop();
     const int g = nodes_[index].g;
@@ -539,9 +646,11 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milesto
         if (it->second <= g2) continue;
         it->second = g2;
       }
+      const int hv = Heuristic(s2, m);
+      if (g0 + g2 + hv > max_cost) continue;  // plan improvement: cannot beat the bound
       const int child = static_cast<int>(nodes_.size());
       nodes_.push_back({std::move(s2), g2, index, a});
-      open.push({g2 + weight_ * Heuristic(nodes_[child].s, m), -g2, sequence++, child});
+      open.push({g2 + weight_ * hv, -g2, sequence++, child});
     }
   }
   return SearchStatus::kExhausted;
@@ -683,43 +792,33 @@ PlanAction TaskSearch::MakeAction(const SymState& s, const TaskAction& a, const 
   return p;
 }
 
+std::string TaskSearch::StepWords(int step) const {
+  const StepInterface& st = world_.interface(step);
+  return "'" + world_.tree->nodes[step].name + "' (moving '" + world_.tree->nodes[st.moved].name +
+         "' onto '" + world_.tree->nodes[st.base].name + "')";
+}
+
 MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymState& s0,
-                                 const ContState& c0, const std::set<std::uint64_t>& excluded) {
+                                 const ContState& c0, const std::set<std::uint64_t>& excluded,
+                                 const FillLimits& limits) {
   const auto start = Clock::now();
-  Milestone m;
-  m.step = step;
-  m.moved = world_.interface(step).moved;
-  m.base = world_.interface(step).base;
-  m.final = next_step < 0;
-  // Objects robots may still hold at the end: the inputs of the next step (none at the end).
-  if (next_step >= 0) {
-    m.keep[0] = world_.interface(next_step).moved;
-    m.keep[1] = world_.interface(next_step).base;
-  }
+  const Milestone m = StepMilestone(step, next_step);
+  weight_ = limits.weight > 0 ? limits.weight : default_weight_;
   tally_ = GateTally{};
   tallied_.clear();
   MilestoneResult result;
+  const std::string words = "milestone " + std::to_string(index + 1) + " " + StepWords(step);
   if (std::string why; !AssemblyPossible(m, &why)) {
-    const StepInterface& st = world_.interface(step);
-    result.failure = "milestone " + std::to_string(index + 1) + " '" +
-                     world_.tree->nodes[step].name + "' (moving '" +
-                     world_.tree->nodes[st.moved].name + "' onto '" +
-                     world_.tree->nodes[st.base].name +
-                     "'): no combination of grasps and supports balances the mating wrench, "
+    result.failure = words +
+                     ": no combination of grasps and supports balances the mating wrench, "
                      "whatever the robots' reach: " + why;
     return result;
   }
   const int levels = 3;
-  std::vector<int> path;
   std::string abstract_failure;  // why the backward abstraction found no way, at the last level
-  // The committed prefix: validated states from s0 on. The search starts from its last state;
-  // a candidate plan's validated edges are committed (greedy, like the paper's lazy greedy fill);
-  // when the search from a committed state finds nothing, that state is abandoned (its entering
-  // edge marked a dead end for this resolution and effort) and the search backs up one state.
-  struct Committed {
-    SymState s;
-    ContState c;
-    std::uint64_t entering_edge = 0;
+  auto finish = [&]() {
+    target_ = AssemblyTarget{};
+    search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
   };
   for (int level = 0; level < levels; ++level) {
     const Resolution res = ResolutionAt(level);
@@ -739,111 +838,258 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
       }
       abstract_failure.clear();  // this level searches: its failures are the report
     }
-    for (int effort = 0; effort <= options_.max_effort; ++effort) {
-      bool suspended_below = false;  // an edge that failed at this effort could be retried
-      std::vector<Committed> prefix{{s0, c0, 0}};
-      std::vector<PlanAction> actions;
-      std::unordered_map<std::uint64_t, bool> dead_ends;  // edges into abandoned states
-      int root_failures = 0;
-      int round_failures = 0;
-      std::unordered_set<std::uint64_t> on_prefix;  // states the committed prefix visited
-      while (!prefix.empty()) {
-        on_prefix.clear();
-        for (const Committed& p : prefix) on_prefix.insert(p.s.Hash());
-        SearchStatus status =
-            BestFirst(prefix.back().s, m, res, effort, excluded, dead_ends, on_prefix,
-                      prefix.size() == 1 ? options_.max_nodes
-                                         : std::min(options_.max_nodes, kLocalNodes),
-                      path);
-        if (std::getenv("WRAP_TASK_DEBUG")) {
-          std::fprintf(stderr,
-                       "[task] milestone %d level %d effort %d depth %zu: status %d, %zu nodes, "
-                       "path %zu\n",
-                       index, level, effort, prefix.size() - 1, static_cast<int>(status),
-                       nodes_.size(), path.size());
-        }
-        if (status == SearchStatus::kStopped) {
-          result.stopped = true;
-          result.failure = tally_.Summary();
-          return result;
-        }
-        if (status == SearchStatus::kFound &&
-            static_cast<int>(prefix.size() - 1 + path.size()) > kMaxMilestoneActions) {
-          status = SearchStatus::kExhausted;  // too long: treat as a dead end
-        }
-        if (status != SearchStatus::kFound) {
-          // Nothing from here: abandon this state.
-          if (prefix.size() == 1) break;
-          dead_ends[prefix.back().entering_edge] = true;
-          prefix.pop_back();
-          actions.pop_back();
-          continue;
-        }
-        // Validate the candidate plan edge by edge, committing what holds.
-        bool valid = true;
-        for (int node_index : path) {
-          if (ctx_.ShouldStop()) {
-            result.stopped = true;
-            result.failure = tally_.Summary();
-            return result;
-          }
-          const SymState& s = prefix.back().s;
-          const ContState& c = prefix.back().c;
-          const TaskAction a = nodes_[node_index].a;
-          const SymState next = nodes_[node_index].s;
-          const std::uint64_t edge = EdgeKey(s, a);
-          const std::uint64_t witness_key = HashMix(c.Fingerprint(s), a.Hash());
-          auto w = witnesses_.find(witness_key);
-          if (w == witnesses_.end()) {
-            auto failed = failed_level_.find(edge);
-            const int edge_level = failed == failed_level_.end() ? 0 : failed->second + 1;
-            EdgeOutcome outcome =
-                solver_.Validate(s, c, a, next, edge_level, HashMix(seed_, edge));
-            if (!outcome.ok) {
-              if (std::getenv("WRAP_TASK_DEBUG")) {
-                std::fprintf(stderr, "[task]   edge %s r%d r%d obj %d: %s: %s%s\n",
-                             std::string(ToString(a.type)).c_str(), a.r1, a.r2, a.obj,
-                             std::string(GateName(outcome.gate)).c_str(), outcome.message.c_str(),
-                             outcome.permanent ? " (permanent)" : "");
-              }
-              tally_.Add(outcome.gate, outcome.message);
-              failed_level_[edge] = outcome.permanent ? kPermanent : edge_level;
-              if (!outcome.permanent && edge_level < options_.max_effort) suspended_below = true;
-              valid = false;
-              break;
-            }
-            w = witnesses_.emplace(witness_key, std::move(outcome)).first;
-          }
-          actions.push_back(MakeAction(s, a, w->second, index));
-          prefix.push_back({next, w->second.next, edge});
-        }
-        if (!valid && ++round_failures > kRoundFailures) break;  // try more effort or width
-        if (!valid && ++root_failures <= kRootFailures) {
-          // Early on, search again from the milestone's start: shorter plans.
-          prefix.resize(1);
-          actions.clear();
-        }
-        if (valid) {
-          result.ok = true;
-          result.actions = std::move(actions);
-          result.end = prefix.back().s;
-          result.end_c = prefix.back().c;
-          search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
-          return result;
-        }
+    std::vector<AssemblyTarget> targets{AssemblyTarget{}};
+    if (optimistic_) targets = OptimisticTargets(m, res, s0);
+    for (const AssemblyTarget& target : targets) {
+      target_ = target;
+      const SearchStatus status = Rounds(index, m, res, s0, c0, excluded, limits, result);
+      if (status != SearchStatus::kExhausted) {
+        finish();
+        return result;
       }
-      if (!suspended_below) break;  // more effort would search the same graph
+    }
+    if (optimistic_ && targets.empty()) {
+      abstract_failure = "no assembly grasp of '" + world_.tree->nodes[m.moved].name +
+                         "' with a support of '" + world_.tree->nodes[m.base].name +
+                         "' balances the mating wrench";
     }
     if (level + 1 < levels) ++widenings_;
   }
-  search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
-  const StepInterface& st = world_.interface(step);
-  result.failure = "milestone " + std::to_string(index + 1) + " '" + world_.tree->nodes[step].name +
-                   "' (moving '" + world_.tree->nodes[st.moved].name + "' onto '" +
-                   world_.tree->nodes[st.base].name +
-                   "'): no plan with every grasp, placement and effort level; " +
-                   (abstract_failure.empty() ? tally_.Summary() : abstract_failure);
+  finish();
+  result.failure = words + ": no plan with every grasp, placement and effort level" +
+                   (limits.max_cost < (1 << 30) ? " within " + std::to_string(limits.max_cost) +
+                                                      " actions"
+                                                : std::string()) +
+                   "; " + (abstract_failure.empty() ? tally_.Summary() : abstract_failure);
   return result;
+}
+
+MilestoneResult TaskSearch::FillFlat(const SymState& s0, const ContState& c0) {
+  const auto start = Clock::now();
+  Milestone m = StepMilestone(flat_order_.back(), -1);
+  m.flat = true;
+  weight_ = default_weight_;
+  tally_ = GateTally{};
+  tallied_.clear();
+  MilestoneResult result;
+  for (int step : flat_order_) {
+    if (std::string why; !AssemblyPossible(StepMilestone(step, -1), &why)) {
+      result.failure = "step " + StepWords(step) +
+                       ": no combination of grasps and supports balances the mating wrench, "
+                       "whatever the robots' reach: " + why;
+      return result;
+    }
+  }
+  const int levels = 3;
+  for (int level = 0; level < levels; ++level) {
+    const SearchStatus status = Rounds(0, m, ResolutionAt(level), s0, c0, {}, {}, result);
+    if (status != SearchStatus::kExhausted) break;
+    if (level + 1 < levels) ++widenings_;
+  }
+  search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
+  if (!result.ok && !result.stopped && !result.out_of_memory) {
+    result.failure = "the whole task (flat, no milestones): no plan with every grasp, placement "
+                     "and effort level; " + tally_.Summary();
+  }
+  return result;
+}
+
+TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const Resolution& res,
+                                            const SymState& s0, const ContState& c0,
+                                            const std::set<std::uint64_t>& excluded,
+                                            const FillLimits& limits, MilestoneResult& result) {
+  // The committed prefix: validated states from s0 on. The search starts from its last state;
+  // a candidate plan's validated edges are committed (greedy, like the paper's lazy greedy fill);
+  // when the search from a committed state finds nothing, that state is abandoned (its entering
+  // edge marked a dead end for this resolution and effort) and the search backs up one state.
+  struct Committed {
+    SymState s;
+    ContState c;
+    std::uint64_t entering_edge = 0;
+  };
+  const int max_actions =
+      std::min(limits.max_cost,
+               m.flat ? kMaxMilestoneActions * static_cast<int>(flat_order_.size())
+                      : kMaxMilestoneActions);
+  // Flat lazy searches the whole task at once: only the memory limit bounds it.
+  const long long root_budget = m.flat ? (1LL << 62) : options_.max_nodes;
+  const long long local_budget = m.flat ? options_.max_nodes : std::min(options_.max_nodes, kLocalNodes);
+  auto stop = [&](SearchStatus status) {
+    result.stopped = status == SearchStatus::kStopped;
+    result.out_of_memory = status == SearchStatus::kOutOfMemory;
+    result.failure = tally_.Summary();
+    return status;
+  };
+  std::vector<int> path;
+  int target_failures = 0;
+  for (int effort = 0; effort <= options_.max_effort; ++effort) {
+    bool suspended_below = false;  // an edge that failed at this effort could be retried
+    std::vector<Committed> prefix{{s0, c0, 0}};
+    std::vector<PlanAction> actions;
+    std::unordered_map<std::uint64_t, bool> dead_ends;  // edges into abandoned states
+    int root_failures = 0;
+    int round_failures = 0;
+    std::unordered_set<std::uint64_t> on_prefix;  // states the committed prefix visited
+    while (!prefix.empty()) {
+      on_prefix.clear();
+      for (const Committed& p : prefix) on_prefix.insert(p.s.Hash());
+      const int g0 = static_cast<int>(prefix.size()) - 1;
+      SearchStatus status =
+          BestFirst(prefix.back().s, m, res, effort, excluded, dead_ends, on_prefix,
+                    prefix.size() == 1 ? root_budget : local_budget, g0, max_actions, path);
+      if (std::getenv("WRAP_TASK_DEBUG")) {
+        std::fprintf(stderr,
+                     "[task] milestone %d effort %d depth %d: status %d, %zu nodes, path %zu\n",
+                     index, effort, g0, static_cast<int>(status), nodes_.size(), path.size());
+      }
+      if (status == SearchStatus::kStopped || status == SearchStatus::kOutOfMemory) {
+        return stop(status);
+      }
+      if (status == SearchStatus::kFound &&
+          g0 + static_cast<int>(path.size()) > max_actions) {
+        status = SearchStatus::kExhausted;  // too long: treat as a dead end
+      }
+      if (status != SearchStatus::kFound) {
+        // Nothing from here: abandon this state.
+        if (prefix.size() == 1) break;
+        dead_ends[prefix.back().entering_edge] = true;
+        prefix.pop_back();
+        actions.pop_back();
+        continue;
+      }
+      // Validate the candidate plan edge by edge, committing what holds.
+      bool valid = true;
+      for (int node_index : path) {
+        if (ctx_.ShouldStop()) return stop(SearchStatus::kStopped);
+        const SymState& s = prefix.back().s;
+        const ContState& c = prefix.back().c;
+        const TaskAction a = nodes_[node_index].a;
+        const SymState next = nodes_[node_index].s;
+        const std::uint64_t edge = EdgeKey(s, a);
+        const std::uint64_t witness_key = HashMix(c.Fingerprint(s), a.Hash());
+        auto w = witnesses_.find(witness_key);
+        if (w == witnesses_.end()) {
+          auto failed = failed_level_.find(edge);
+          const int edge_level = failed == failed_level_.end() ? 0 : failed->second + 1;
+          EdgeOutcome outcome = solver_.Validate(s, c, a, next, edge_level, HashMix(seed_, edge));
+          if (!outcome.ok) {
+            if (std::getenv("WRAP_TASK_DEBUG")) {
+              std::fprintf(stderr, "[task]   edge %s r%d r%d obj %d: %s: %s%s\n",
+                           std::string(ToString(a.type)).c_str(), a.r1, a.r2, a.obj,
+                           std::string(GateName(outcome.gate)).c_str(), outcome.message.c_str(),
+                           outcome.permanent ? " (permanent)" : "");
+            }
+            tally_.Add(outcome.gate, outcome.message);
+            failed_level_[edge] = outcome.permanent ? kPermanent : edge_level;
+            // Optimistic: an assembly with the target's grasps that fails for good several
+            // times is a bad choice of target, not of the way there.
+            if (target_.rm >= 0 && a.type == ActionType::kAssemble && outcome.permanent &&
+                ++target_failures >= kTargetFailures) {
+              return SearchStatus::kExhausted;
+            }
+            if (!outcome.permanent && edge_level < options_.max_effort) suspended_below = true;
+            valid = false;
+            break;
+          }
+          w = witnesses_.emplace(witness_key, std::move(outcome)).first;
+        }
+        actions.push_back(MakeAction(s, a, w->second, index));
+        prefix.push_back({next, w->second.next, edge});
+      }
+      if (!valid && ++round_failures > kRoundFailures) break;  // try more effort or width
+      if (!valid && ++root_failures <= kRootFailures) {
+        // Early on, search again from the milestone's start: shorter plans.
+        prefix.resize(1);
+        actions.clear();
+      }
+      if (valid) {
+        result.ok = true;
+        result.actions = std::move(actions);
+        result.end = prefix.back().s;
+        result.end_c = prefix.back().c;
+        return SearchStatus::kFound;
+      }
+    }
+    if (!suspended_below) break;  // more effort would search the same graph
+  }
+  return SearchStatus::kExhausted;
+}
+
+std::vector<TaskSearch::AssemblyTarget> TaskSearch::OptimisticTargets(const Milestone& m,
+                                                                      const Resolution& res,
+                                                                      const SymState& s0) {
+  // Like Dogar et al.: the assembly's grasps (and the base's support) are chosen first, by the
+  // checks of the assembly alone (reach and clearance at the mating pose where the base rests,
+  // the wrench LP), without asking how the robots get there; the search then plans the picks,
+  // handovers and set-downs to reach them. Grasps in set order (best spread first), robots
+  // interleaved; per grasp the base resting where it is, else braced, else held in the air.
+  constexpr int kTargets = 8;
+  SetClasses(m);
+  target_start_loc_ = s0.loc[m.base];
+  std::vector<AssemblyTarget> targets;
+  // The assembly check on a hypothetical state: s0 with the chosen grasps in hand.
+  auto holds = [&](const AssemblyTarget& t) {
+    SymState s = s0;
+    for (int r = 0; r < n_robots_; ++r) {
+      if (s.held[r] == m.moved || s.held[r] == m.base) {
+        s.held[r] = -1;
+        s.grasp[r] = -1;
+      }
+    }
+    s.loc[m.moved] = kInAir;
+    s.held[t.rm] = static_cast<int16_t>(m.moved);
+    s.grasp[t.rm] = t.gm;
+    if (!t.base_rests) s.loc[m.base] = kInAir;
+    if (t.rb >= 0) {
+      s.held[t.rb] = static_cast<int16_t>(m.base);
+      s.grasp[t.rb] = t.gb;
+    }
+    return CheapAssemble(s, m);
+  };
+  auto first_support = [&](AssemblyTarget t) -> std::optional<AssemblyTarget> {
+    for (int rb = 0; rb < n_robots_; ++rb) {
+      if (rb == t.rm) continue;
+      const std::vector<int>& ids = GraspIds(m.base, rb);
+      for (int j = 0; j < std::min<int>(res.grasps, static_cast<int>(ids.size())); ++j) {
+        if (!AssemblyGrasp(1, rb, ids[j])) continue;
+        t.rb = rb;
+        t.gb = ids[j];
+        if (holds(t)) return t;
+      }
+    }
+    return std::nullopt;
+  };
+  int most = 0;
+  for (int r = 0; r < n_robots_; ++r) {
+    most = std::max(most, static_cast<int>(GraspIds(m.moved, r).size()));
+  }
+  most = std::min(most, res.grasps);
+  const bool base_rests = s0.loc[m.base] >= 0;
+  for (int i = 0; i < most && static_cast<int>(targets.size()) < kTargets; ++i) {
+    for (int r = 0; r < n_robots_ && static_cast<int>(targets.size()) < kTargets; ++r) {
+      const std::vector<int>& ids = GraspIds(m.moved, r);
+      if (i >= static_cast<int>(ids.size()) || !AssemblyGrasp(0, r, ids[i])) continue;
+      AssemblyTarget t{r, ids[i], -1, -1, base_rests};
+      if (base_rests && holds(t)) {
+        targets.push_back(t);
+        continue;
+      }
+      if (base_rests) {
+        // Optimistic about the pose too: the base set down in some placement elsewhere.
+        AssemblyTarget placed = t;
+        placed.base_moved = true;
+        targets.push_back(placed);
+      }
+      std::optional<AssemblyTarget> found;
+      if (base_rests) found = first_support(t);
+      if (!found) {
+        t.base_rests = false;
+        found = first_support(t);
+      }
+      if (found) targets.push_back(*found);
+    }
+  }
+  return targets;
 }
 
 }  // namespace wrap

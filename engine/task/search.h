@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <map>
 #include <set>
 #include <string>
@@ -39,7 +40,14 @@ struct MilestoneResult {
   std::vector<PlanAction> actions;   ///< The validated actions.
   SymState end;                      ///< Symbolic state at its end.
   ContState end_c;                   ///< Continuous state at its end.
+  bool out_of_memory = false;        ///< Stopped by TaskPlannerOptions::memory_limit_mb.
   std::string failure;               ///< Why not, when !ok.
+};
+
+/// Limits of one fill beyond the variant's own, for plan improvement.
+struct FillLimits {
+  int weight = 0;              ///< f = g + weight h; 0: the variant's (2, exact 1).
+  int max_cost = 1 << 30;      ///< Most actions in the milestone (A* prunes g + h above it).
 };
 
 /// The lazy search of the task planner.
@@ -55,7 +63,11 @@ class TaskSearch {
   /// `next_step` (the next milestone's step; -1 for the last milestone: every robot free). End
   /// states whose hash is in `excluded` do not count as goals (backtracking).
   MilestoneResult Fill(int index, int step, int next_step, const SymState& s0, const ContState& c0,
-                       const std::set<std::uint64_t>& excluded);
+                       const std::set<std::uint64_t>& excluded, const FillLimits& limits = {});
+  /// The paper's "Flat lazy": one lazy search over the whole task from s0 to the final product
+  /// released, any step whose inputs exist may be assembled next (no milestones). The actions'
+  /// milestone index is the number of steps assembled before them.
+  MilestoneResult FillFlat(const SymState& s0, const ContState& c0);
 
   long long expansions() const { return expansions_; }
   int widenings() const { return widenings_; }
@@ -75,6 +87,15 @@ class TaskSearch {
     int base = -1;
     bool final = false;
     int keep[2] = {-2, -2};  ///< Nodes robots may still hold at the end.
+    bool flat = false;       ///< Flat lazy: the whole task (step: the final product).
+  };
+  /// Optimistic (Dogar et al.): the assembly's grasps chosen before the search; the search must
+  /// assemble with them. rm < 0: any.
+  struct AssemblyTarget {
+    int rm = -1, gm = -1;  ///< Robot and grasp id holding the moved input.
+    int rb = -1, gb = -1;  ///< Robot and grasp id holding (or bracing) the base; rb < 0: none.
+    bool base_rests = false;  ///< The base rests on the table (braced when rb >= 0) ...
+    bool base_moved = false;  ///< ... not where it rested at the milestone's start.
   };
   struct Node {
     SymState s;
@@ -82,7 +103,7 @@ class TaskSearch {
     int parent = -1;
     TaskAction a;
   };
-  enum class SearchStatus { kFound, kExhausted, kNodeLimit, kStopped };
+  enum class SearchStatus { kFound, kExhausted, kNodeLimit, kStopped, kOutOfMemory };
 
   Resolution ResolutionAt(int level) const;
   const std::vector<int>& GraspIds(int node, int robot);
@@ -91,18 +112,41 @@ class TaskSearch {
   /// resolution `res` from the start state s0, and its distance of a forward state.
   void BuildBackward(const Milestone& m, const Resolution& res, const SymState& s0);
   int BackwardDistance(const SymState& s);
+  /// The class of grasp id `grasp` of input `input` held by `robot` in the abstraction: assembly
+  /// grasp or not (bit 0) and, for the fine projection, the approach direction in the object's
+  /// frame (one of six).
+  int GraspClass(int input, int robot, int grasp);
   /// Whether grasp id `grasp` of input 0 (moved) or 1 (base) of the current milestone is an
   /// assembly grasp: the gripper clears the other input at the mating pose. Cached.
   bool AssemblyGrasp(int input, int robot, int grasp);
   bool IsGoal(const SymState& s, const Milestone& m, const std::set<std::uint64_t>& excluded) const;
   void Successors(const SymState& s, const Milestone& m, const Resolution& res,
                   std::vector<std::pair<TaskAction, SymState>>& out);
+  /// Flat lazy: the successors of every step whose inputs exist (and of the final product).
+  void FlatSuccessors(const SymState& s, const Resolution& res,
+                      std::vector<std::pair<TaskAction, SymState>>& out);
+  Milestone StepMilestone(int step, int next_step) const;
+  /// e.g. "'seat+leg0' (moving 'leg0' onto 'seat')".
+  std::string StepWords(int step) const;
+  /// The effort rounds of one resolution (the lazy search with validation and commits): kFound
+  /// with `result` filled, kStopped / kOutOfMemory, or kExhausted.
+  SearchStatus Rounds(int index, const Milestone& m, const Resolution& res, const SymState& s0,
+                      const ContState& c0, const std::set<std::uint64_t>& excluded,
+                      const FillLimits& limits, MilestoneResult& result);
+  /// Optimistic: assembly targets of milestone `m` chosen by the wrench LP alone (no reach).
+  std::vector<AssemblyTarget> OptimisticTargets(const Milestone& m, const Resolution& res,
+                                                const SymState& s0);
+  bool TargetAllows(const SymState& s, const Milestone& m) const;
+  /// Points the grasp-class caches at milestone `m`'s inputs.
+  void SetClasses(const Milestone& m);
+  /// Estimated bytes held by the search (nodes, queue, caches), for the memory limit.
+  std::size_t MemoryBytes(std::size_t open, std::size_t closed) const;
   SymState Apply(const SymState& s, const TaskAction& a) const;
   SearchStatus BestFirst(const SymState& s0, const Milestone& m, const Resolution& res, int effort,
                          const std::set<std::uint64_t>& excluded,
                          const std::unordered_map<std::uint64_t, bool>& dead_ends,
                          const std::unordered_set<std::uint64_t>& forbidden,
-                         long long node_budget, std::vector<int>& path);
+                         long long node_budget, int g0, int max_cost, std::vector<int>& path);
   bool CheapPick(int robot, int node, int loc, int grasp);
   bool CheapPlace(int robot, int node, int loc, int grasp);
   bool CheapAssemble(const SymState& s, const Milestone& m);
@@ -123,6 +167,7 @@ class TaskSearch {
     int n_place[2] = {0, 0};   ///< Placements of each input in the abstraction.
     int n_rest[2] = {0, 0};    ///< Rest statuses: the start location, then the placements.
     int n_status[2] = {0, 0};  ///< Rest statuses, then (robot, grasp class) pairs.
+    int classes = 2;           ///< Grasp classes: 2, or 12 for the fine projection.
     std::unordered_map<int, bool> assembly_grasp[2];  ///< Grasp id -> assembly class.
     std::vector<int> dist;     ///< Per (moved status, base status): actions to the assembly.
     std::string why;           ///< Why the start is kFarDistance away (empty otherwise).
@@ -138,7 +183,14 @@ class TaskSearch {
   bool widen_;
   int n_robots_ = 0;
   bool use_backward_ = false;  ///< wrap, exact: the backward heuristic replaces counting.
-  int weight_ = 2;             ///< f = g + weight h: 2 (weighted best-first), 1 for "exact".
+  int default_weight_ = 2;     ///< f = g + weight h: 2 (weighted best-first), 1 for "exact".
+  int weight_ = 2;             ///< This fill's weight.
+  bool fine_ = false;          ///< "fine": the backward abstraction's classes split by direction.
+  bool flat_ = false;          ///< "flat": FillFlat instead of milestones.
+  bool optimistic_ = false;    ///< "optimistic": assembly targets chosen first.
+  AssemblyTarget target_;      ///< The current optimistic target.
+  int target_start_loc_ = -1;  ///< Where the base rested at the target's milestone start.
+  std::vector<int> flat_order_;  ///< Steps in the DAG's topological order.
   std::vector<Node> nodes_;
   std::map<std::pair<int, int>, std::vector<int>> grasp_ids_;
   std::unordered_map<std::uint64_t, int> failed_level_;   // edge key -> level failed at
