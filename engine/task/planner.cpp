@@ -1,5 +1,6 @@
 #include "task/planner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -26,6 +27,12 @@ std::string ModeName(MatingWrenchMode mode) {
   return "?";
 }
 
+// Plan improvement: edge validation failures before a window's (or a refill's) search gives up:
+// a neighbourhood that costs much validation is left for the next one.
+constexpr int kWindowFailures = 60;
+// ... and search nodes per milestone of the window.
+constexpr long long kWindowNodes = 40000;
+
 int CostOf(const std::vector<MilestoneResult>& results, int from, int to) {
   int cost = 0;
   for (int j = from; j < to; ++j) cost += static_cast<int>(results[j].actions.size());
@@ -33,9 +40,11 @@ int CostOf(const std::vector<MilestoneResult>& results, int from, int to) {
 }
 
 // Plan improvement (paper §IV-D, "anytime"): a large neighbourhood search over the milestones of
-// the incumbent. A window of n milestones is refilled by weight-one A* fills bounded by the
-// window's cost, the milestones after it are refilled by the variant's own fills (or kept, when
-// the window ends in the incumbent's state) bounded so that the whole plan is strictly cheaper;
+// the incumbent. A window of n milestones is refilled by one weight-one lazy A* search over its
+// n milestones bounded by the window's cost (one milestone: the variant's heuristic; more: the
+// counting heuristic over the window), the milestones after it are refilled by the variant's
+// own fills (or kept, when the window ends in the incumbent's state) bounded so that the whole
+// plan is strictly cheaper;
 // a cheaper plan replaces the incumbent. n grows from 1 to the whole horizon; the search stops
 // early at the time limit or on cancellation. Returns false when it was stopped.
 bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& s0,
@@ -52,10 +61,41 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
       std::vector<MilestoneResult> candidate(incumbent.begin(), incumbent.begin() + i);
       SymState s = i == 0 ? s0 : incumbent[i - 1].end;
       ContState c = i == 0 ? c0 : incumbent[i - 1].end_c;
-      int running = 0;
+      // The window: one weight-one search over its n milestones, no worse than before.
+      FillLimits window;
+      window.weight = 1;
+      window.max_failures = kWindowFailures;
+      window.max_nodes = kWindowNodes;
+      window.max_cost = std::min(window_cost, budget - (K - i - n));
+      if (window.max_cost < n) continue;
+      const int next = i + n < K ? order[i + n] : -1;
+      MilestoneResult w =
+          n == 1 ? search.Fill(i, order[i], next, s, c, {}, window)
+                 : search.FillWindow(i, std::vector<int>(order.begin() + i, order.begin() + i + n),
+                                     next, s, c, window);
+      if (debug) {
+        std::fprintf(stderr, "[opt] window %d+%d (cost %d, bound %d): %s %zu at %.2f s\n", i, n,
+                     window_cost, window.max_cost, w.ok ? "found" : "none", w.actions.size(),
+                     std::chrono::duration<double>(Clock::now() - start).count());
+      }
+      if (w.stopped || w.out_of_memory) return false;
+      if (!w.ok) continue;
+      int running = static_cast<int>(w.actions.size());
+      s = w.end;
+      c = w.end_c;
+      // The window's actions fill candidate milestones i .. i+n-1 (by their milestone index).
+      // (A milestone ends with its last action; the window's last one with the window.)
+      for (int j = i; j < i + n; ++j) candidate.emplace_back().ok = true;
+      for (size_t t = 0; t < w.actions.size(); ++t) {
+        const int j = std::clamp(w.actions[t].milestone, i, i + n - 1);
+        w.actions[t].milestone = j;
+        candidate[j].actions.push_back(std::move(w.actions[t]));
+        candidate[j].end = w.after[t].first;
+        candidate[j].end_c = w.after[t].second;
+      }
       bool ok = true;
-      for (int j = i; j < K && ok; ++j) {
-        if (j >= i + n && s == incumbent[j - 1].end &&
+      for (int j = i + n; j < K && ok; ++j) {
+        if (s == incumbent[j - 1].end &&
             c.Fingerprint(s) == incumbent[j - 1].end_c.Fingerprint(s)) {
           // The window ends where the incumbent's did: the rest holds as it is.
           for (int t = j; t < K; ++t) candidate.push_back(incumbent[t]);
@@ -63,11 +103,9 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
           break;
         }
         FillLimits limits;
+        limits.max_failures = kWindowFailures;
+        limits.max_nodes = kWindowNodes;
         limits.max_cost = budget - running - (K - j - 1);  // later milestones take >= 1 each
-        if (j < i + n) {
-          limits.weight = 1;
-          limits.max_cost = std::min(limits.max_cost, window_cost - running - (i + n - j - 1));
-        }
         if (limits.max_cost < 1) {
           ok = false;
           break;

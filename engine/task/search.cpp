@@ -170,6 +170,23 @@ bool TaskSearch::GraspsApart(int grasp_a, int grasp_b) const {
 
 int TaskSearch::Heuristic(const SymState& s, const Milestone& m) {
   int h = 0;
+  if (m.flat && !window_.empty()) {
+    // A window of milestones: per step still to assemble the assembly and, when its moved input
+    // rests on the table, a pick; a release per object held that no step still needs.
+    const int done = WindowDone(s);
+    const int n = static_cast<int>(window_.size());
+    for (int t = done; t < n; ++t) h += 1 + (s.loc[world_.interface(window_[t]).moved] >= 0 ? 1 : 0);
+    for (int r = 0; r < n_robots_; ++r) {
+      const int o = s.held[r];
+      if (o < 0 || o == m.keep[0] || o == m.keep[1]) continue;
+      bool needed = false;
+      for (int t = done; t < n && !needed; ++t) {
+        needed = o == world_.interface(window_[t]).moved || o == world_.interface(window_[t]).base;
+      }
+      if (!needed) h += 1;
+    }
+    return h;
+  }
   if (m.flat) {
     // Flat lazy: per step not yet assembled the assembly and, when its moved input exists but
     // is not in a hand, a pick; a release per robot holding something.
@@ -223,6 +240,12 @@ bool TaskSearch::TargetAllows(const SymState& s, const Milestone& m) const {
 bool TaskSearch::IsGoal(const SymState& s, const Milestone& m,
                         const std::set<std::uint64_t>& excluded) const {
   if (s.loc[m.step] == kInactive) return false;
+  if (m.flat && !window_.empty()) {
+    for (int r = 0; r < n_robots_; ++r) {
+      if (s.held[r] >= 0 && s.held[r] != m.keep[0] && s.held[r] != m.keep[1]) return false;
+    }
+    return true;
+  }
   if (m.flat) {
     for (int r = 0; r < n_robots_; ++r) {
       if (s.held[r] >= 0) return false;
@@ -444,6 +467,17 @@ void TaskSearch::FlatSuccessors(const SymState& s, const Resolution& res,
       if (seen.insert(e.first.Hash()).second) out.push_back(std::move(e));
     }
   };
+  if (!window_.empty()) {
+    // A window of milestones: the steps in their order.
+    const int t = WindowDone(s);
+    const int n = static_cast<int>(window_.size());
+    if (t < n) {
+      add(StepMilestone(window_[t], t + 1 < n ? window_[t + 1] : window_next_));
+    } else {
+      add(StepMilestone(window_.back(), window_next_));
+    }
+    return;
+  }
   for (int step : flat_order_) {
     if (s.loc[step] != kInactive) continue;
     const StepInterface& st = world_.interface(step);
@@ -806,6 +840,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   weight_ = limits.weight > 0 ? limits.weight : default_weight_;
   tally_ = GateTally{};
   tallied_.clear();
+  fill_failures_ = 0;
   MilestoneResult result;
   const std::string words = "milestone " + std::to_string(index + 1) + " " + StepWords(step);
   if (std::string why; !AssemblyPossible(m, &why)) {
@@ -864,6 +899,38 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   return result;
 }
 
+int TaskSearch::WindowDone(const SymState& s) const {
+  for (int t = static_cast<int>(window_.size()) - 1; t >= 0; --t) {
+    if (s.loc[window_[t]] != kInactive) return t + 1;
+  }
+  return 0;
+}
+
+MilestoneResult TaskSearch::FillWindow(int index, const std::vector<int>& steps, int next_step,
+                                       const SymState& s0, const ContState& c0,
+                                       const FillLimits& limits) {
+  const auto start = Clock::now();
+  window_ = steps;
+  window_next_ = next_step;
+  Milestone m = StepMilestone(steps.back(), next_step);
+  m.flat = true;
+  weight_ = limits.weight > 0 ? limits.weight : default_weight_;
+  tally_ = GateTally{};
+  tallied_.clear();
+  fill_failures_ = 0;
+  MilestoneResult result;
+  const int levels = 3;
+  for (int level = 0; level < levels; ++level) {
+    if (Rounds(index, m, ResolutionAt(level), s0, c0, {}, limits, result) !=
+        SearchStatus::kExhausted) {
+      break;
+    }
+  }
+  window_.clear();
+  search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
+  return result;
+}
+
 MilestoneResult TaskSearch::FillFlat(const SymState& s0, const ContState& c0) {
   const auto start = Clock::now();
   Milestone m = StepMilestone(flat_order_.back(), -1);
@@ -871,6 +938,7 @@ MilestoneResult TaskSearch::FillFlat(const SymState& s0, const ContState& c0) {
   weight_ = default_weight_;
   tally_ = GateTally{};
   tallied_.clear();
+  fill_failures_ = 0;
   MilestoneResult result;
   for (int step : flat_order_) {
     if (std::string why; !AssemblyPossible(StepMilestone(step, -1), &why)) {
@@ -909,11 +977,17 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
   };
   const int max_actions =
       std::min(limits.max_cost,
-               m.flat ? kMaxMilestoneActions * static_cast<int>(flat_order_.size())
+               m.flat ? kMaxMilestoneActions * static_cast<int>(window_.empty()
+                                                                    ? flat_order_.size()
+                                                                    : window_.size())
                       : kMaxMilestoneActions);
   // Flat lazy searches the whole task at once: only the memory limit bounds it.
-  const long long root_budget = m.flat ? (1LL << 62) : options_.max_nodes;
-  const long long local_budget = m.flat ? options_.max_nodes : std::min(options_.max_nodes, kLocalNodes);
+  const long long max_nodes = limits.max_nodes > 0 ? limits.max_nodes : options_.max_nodes;
+  const long long root_budget =
+      !m.flat ? max_nodes
+              : window_.empty() ? (1LL << 62)
+                                : max_nodes * static_cast<long long>(window_.size());
+  const long long local_budget = m.flat ? max_nodes : std::min(max_nodes, kLocalNodes);
   auto stop = [&](SearchStatus status) {
     result.stopped = status == SearchStatus::kStopped;
     result.out_of_memory = status == SearchStatus::kOutOfMemory;
@@ -981,6 +1055,7 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
             }
             tally_.Add(outcome.gate, outcome.message);
             failed_level_[edge] = outcome.permanent ? kPermanent : edge_level;
+            if (++fill_failures_ > limits.max_failures) return SearchStatus::kExhausted;
             // Optimistic: an assembly with the target's grasps that fails for good several
             // times is a bad choice of target, not of the way there.
             if (target_.rm >= 0 && a.type == ActionType::kAssemble && outcome.permanent &&
@@ -993,7 +1068,8 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
           }
           w = witnesses_.emplace(witness_key, std::move(outcome)).first;
         }
-        actions.push_back(MakeAction(s, a, w->second, index));
+        actions.push_back(MakeAction(s, a, w->second,
+                                     m.flat && !window_.empty() ? index + WindowDone(s) : index));
         prefix.push_back({next, w->second.next, edge});
       }
       if (!valid && ++round_failures > kRoundFailures) break;  // try more effort or width
@@ -1005,6 +1081,8 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
       if (valid) {
         result.ok = true;
         result.actions = std::move(actions);
+        result.after.clear();
+        for (size_t i = 1; i < prefix.size(); ++i) result.after.push_back({prefix[i].s, prefix[i].c});
         result.end = prefix.back().s;
         result.end_c = prefix.back().c;
         return SearchStatus::kFound;

@@ -38,6 +38,8 @@ struct MilestoneResult {
   bool ok = false;
   bool stopped = false;              ///< Cancelled or out of time.
   std::vector<PlanAction> actions;   ///< The validated actions.
+  /// The state after each action (plan improvement splits a window's actions by milestone).
+  std::vector<std::pair<SymState, ContState>> after;
   SymState end;                      ///< Symbolic state at its end.
   ContState end_c;                   ///< Continuous state at its end.
   bool out_of_memory = false;        ///< Stopped by TaskPlannerOptions::memory_limit_mb.
@@ -48,6 +50,8 @@ struct MilestoneResult {
 struct FillLimits {
   int weight = 0;              ///< f = g + weight h; 0: the variant's (2, exact 1).
   int max_cost = 1 << 30;      ///< Most actions in the milestone (A* prunes g + h above it).
+  int max_failures = 1 << 30;  ///< Edge validation failures before the fill gives up.
+  long long max_nodes = 0;     ///< Nodes per search; 0: TaskPlannerOptions::max_nodes.
 };
 
 /// The lazy search of the task planner.
@@ -68,6 +72,11 @@ class TaskSearch {
   /// released, any step whose inputs exist may be assembled next (no milestones). The actions'
   /// milestone index is the number of steps assembled before them.
   MilestoneResult FillFlat(const SymState& s0, const ContState& c0);
+  /// Plan improvement: one search over the milestones `steps` (in their order; the first is
+  /// milestone `index`) from s0, ending with robots holding only the inputs of `next_step` (-1:
+  /// nothing). Counting heuristic; the actions carry their milestone indices.
+  MilestoneResult FillWindow(int index, const std::vector<int>& steps, int next_step,
+                             const SymState& s0, const ContState& c0, const FillLimits& limits);
 
   long long expansions() const { return expansions_; }
   int widenings() const { return widenings_; }
@@ -191,6 +200,11 @@ class TaskSearch {
   AssemblyTarget target_;      ///< The current optimistic target.
   int target_start_loc_ = -1;  ///< Where the base rested at the target's milestone start.
   std::vector<int> flat_order_;  ///< Steps in the DAG's topological order.
+  std::vector<int> window_;      ///< FillWindow's steps (empty: FillFlat's whole task).
+  int window_next_ = -1;         ///< The step after the window (-1: none).
+  int fill_failures_ = 0;        ///< Edge validation failures in the current fill.
+  /// Steps of the window assembled in `s` (they are assembled in order).
+  int WindowDone(const SymState& s) const;
   std::vector<Node> nodes_;
   std::map<std::pair<int, int>, std::vector<int>> grasp_ids_;
   std::unordered_map<std::uint64_t, int> failed_level_;   // edge key -> level failed at
