@@ -837,7 +837,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
                                  const FillLimits& limits) {
   const auto start = Clock::now();
   const Milestone m = StepMilestone(step, next_step);
-  weight_ = limits.weight > 0 ? limits.weight : default_weight_;
+  weight_ = limits.weight >= 0 ? limits.weight : default_weight_;
   tally_ = GateTally{};
   tallied_.clear();
   fill_failures_ = 0;
@@ -899,6 +899,12 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   return result;
 }
 
+int TaskSearch::StartHeuristic(int step, int next_step, const SymState& s) {
+  const Milestone m = StepMilestone(step, next_step);
+  if (use_backward_) BuildBackward(m, ResolutionAt(2), s);
+  return Heuristic(s, m);
+}
+
 int TaskSearch::WindowDone(const SymState& s) const {
   for (int t = static_cast<int>(window_.size()) - 1; t >= 0; --t) {
     if (s.loc[window_[t]] != kInactive) return t + 1;
@@ -914,7 +920,7 @@ MilestoneResult TaskSearch::FillWindow(int index, const std::vector<int>& steps,
   window_next_ = next_step;
   Milestone m = StepMilestone(steps.back(), next_step);
   m.flat = true;
-  weight_ = limits.weight > 0 ? limits.weight : default_weight_;
+  weight_ = limits.weight >= 0 ? limits.weight : default_weight_;
   tally_ = GateTally{};
   tallied_.clear();
   fill_failures_ = 0;

@@ -48,7 +48,7 @@ struct MilestoneResult {
 
 /// Limits of one fill beyond the variant's own, for plan improvement.
 struct FillLimits {
-  int weight = 0;              ///< f = g + weight h; 0: the variant's (2, exact 1).
+  int weight = -1;             ///< f = g + weight h; -1: the variant's (2, exact 1); 0: none.
   int max_cost = 1 << 30;      ///< Most actions in the milestone (A* prunes g + h above it).
   int max_failures = 1 << 30;  ///< Edge validation failures before the fill gives up.
   long long max_nodes = 0;     ///< Nodes per search; 0: TaskPlannerOptions::max_nodes.
@@ -77,6 +77,10 @@ class TaskSearch {
   /// nothing). Counting heuristic; the actions carry their milestone indices.
   MilestoneResult FillWindow(int index, const std::vector<int>& steps, int next_step,
                              const SymState& s0, const ContState& c0, const FillLimits& limits);
+
+  /// The variant's heuristic of `s` at the start of milestone (`step`, `next_step`), with the
+  /// backward abstraction built from `s` at the widest resolution (tests: admissibility).
+  int StartHeuristic(int step, int next_step, const SymState& s);
 
   long long expansions() const { return expansions_; }
   int widenings() const { return widenings_; }

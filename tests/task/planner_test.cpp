@@ -10,68 +10,13 @@
 #include <string>
 #include <thread>
 
-#include "grasp/preprocess.h"
-#include "model/validate.h"
-#include "task/plan_json.h"
-#include "task/plan_validator.h"
+#include "planning_fixture.h"
 #include "task/keyframes.h"
-#include "task/planner.h"
+#include "task/plan_json.h"
 #include "task/world.h"
 
 namespace wrap {
 namespace {
-
-namespace fs = std::filesystem;
-
-fs::path ProjectFile(const std::string& name) {
-  return fs::path(WRAP_SOURCE_DIR) / "projects" / (name + ".json");
-}
-
-// Preprocesses `lp`'s project with the default options (seed 0).
-Result<Preprocessed> PreprocessProject(const LoadedProject& lp, const fs::path& file) {
-  RunContext ctx(0);
-  PreprocessOptions options;
-  options.project_file = file;
-  return Preprocess(*lp.project, lp.check, options, ctx);
-}
-
-struct PlanRun {
-  Result<Plan> plan = Fail(ErrorCode::kInternal, "not run");
-  std::optional<PlanValidation> validation;
-};
-
-// Preprocesses and plans `project` (already loaded and checked), then validates the plan.
-PlanRun PlanAndValidate(const Project& project, const ProjectCheck& check, const fs::path& file,
-                    std::uint64_t seed, double time_limit_s,
-                    const TaskPlannerOptions& base_options = {}) {
-  PlanRun run;
-  RunContext ctx(seed);
-  ctx.set_time_limit_s(time_limit_s);
-  PreprocessOptions pre_options;
-  pre_options.project_file = file;
-  auto pre = Preprocess(project, check, pre_options, ctx);
-  if (!pre) {
-    run.plan = std::unexpected(pre.error());
-    return run;
-  }
-  TaskPlannerOptions options = base_options;
-  options.project_file = file;
-  run.plan = PlanTask(project, check, *pre, options, ctx);
-  if (run.plan && run.plan->stats.solved) {
-    PlanValidationOptions v;
-    v.wrench_mode = options.wrench_mode;
-    v.force_scale = options.force_scale;
-    auto validation = ValidatePlan(project, check, *run.plan, v, file);
-    if (validation) run.validation = *validation;
-  }
-  return run;
-}
-
-std::string Issues(const PlanValidation& v) {
-  std::string out;
-  for (const PlanIssue& i : v.issues) out += FormatIssue(i) + "\n";
-  return out;
-}
 
 // An object set down where a robot's home pose reaches (here: right at ur5e_a's base) would leave
 // that robot nowhere to go: ClearOfHomes says so; the seat where it starts leaves every home free.
@@ -134,41 +79,6 @@ INSTANTIATE_TEST_SUITE_P(Projects, ExamplePlan,
                                            "fabrica_plumbers_block", "fabrica_beam",
                                            "fabrica_car"),
                          [](const auto& param_info) { return param_info.param; });
-
-// The backward-heuristic variants ("wrap"; "exact": the paper's exact fills, weight-one A*) on
-// projects they solve fast; their plans pass the same validator and their stats hold the
-// backward search's time. Parameter: "variant/project".
-class WrapPlan : public ::testing::TestWithParam<std::string> {};
-
-TEST_P(WrapPlan, IsSolvedAndValid) {
-  const std::string variant = GetParam().substr(0, GetParam().find('/'));
-  const std::string project = GetParam().substr(GetParam().find('/') + 1);
-  const fs::path file = ProjectFile(project);
-  const LoadedProject lp = LoadProject(file);
-  if (!lp.ok() && project.starts_with("fabrica")) {
-    GTEST_SKIP() << "the Fabrica meshes are not beside the repository (../shared/fabrica)";
-  }
-  ASSERT_TRUE(lp.ok()) << project;
-  TaskPlannerOptions options;
-  options.planner = variant;
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 240.0, options);
-  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
-  ASSERT_TRUE(run.plan->stats.solved) << GetParam() << ": " << run.plan->stats.failure;
-  EXPECT_EQ(run.plan->stats.planner, variant);
-  EXPECT_GT(run.plan->stats.t_bwd_s, 0.0);
-  ASSERT_TRUE(run.validation.has_value());
-  EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
-}
-
-INSTANTIATE_TEST_SUITE_P(Projects, WrapPlan,
-                         ::testing::Values("wrap/stool", "wrap/cross", "wrap/cube",
-                                           "wrap/cube_2x2x3", "wrap/fabrica_car",
-                                           "wrap/fabrica_beam", "exact/cross"),
-                         [](const auto& param_info) {
-                           std::string name = param_info.param;
-                           std::replace(name.begin(), name.end(), '/', '_');
-                           return name;
-                         });
 
 // When the backward abstraction cannot reach a step's assembly, WRAP says why at once instead of
 // searching: here wheel0 has lost every grasp (and the wrench model is off, so that the wrench
