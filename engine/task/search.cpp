@@ -25,8 +25,10 @@ constexpr long long kLocalNodes = 20000;
 constexpr int kRootFailures = 15;
 // Most actions in one milestone's plan: longer candidates count as dead ends.
 constexpr int kMaxMilestoneActions = 16;
-// Optimistic: permanent failures of the target's assembly before the next target.
+// Optimistic: failures of the target's assembly before the next target.
 constexpr int kTargetFailures = 3;
+// Optimistic: nodes of a search towards one target (an unreachable target exhausts it).
+constexpr long long kTargetNodes = 200000;
 // Validation failures in one round (resolution and effort level) before moving to the next.
 constexpr int kRoundFailures = 400;
 
@@ -221,11 +223,25 @@ int TaskSearch::Heuristic(const SymState& s, const Milestone& m) {
     if (s.held[r] >= 0 && s.held[r] != m.keep[0] && s.held[r] != m.keep[1]) h += 1;
   }
   if (m.final && m_needs_grasp) h += 1;
-  // Optimistic: the moved input in another hand or grasp than the target's needs a handover.
-  if (!done && target_.rm >= 0 && !m_needs_grasp &&
-      !(s.held[target_.rm] == m.moved && s.grasp[target_.rm] == target_.gm)) {
-    h += 1;
-  }
+  if (!done && target_.rm >= 0) h += TargetDistance(s, m);
+  return h;
+}
+
+int TaskSearch::TargetDistance(const SymState& s, const Milestone& m) {
+  // Optimistic: actions beyond the counting ones that the target's grasps need. An input held
+  // with another grasp or by another robot than the target's needs a handover (or a set-down and
+  // a pick); one resting where the target's robot cannot take it with the target's grasp needs
+  // a regrasp first; a base to rest that is held needs a set-down.
+  int h = 0;
+  auto grasp_distance = [&](int node, int robot, int grasp) {
+    if (s.held[robot] == node && s.grasp[robot] == grasp) return 0;
+    if (s.loc[node] >= 0) return CheapPick(robot, node, s.loc[node], grasp) ? 0 : 2;
+    return 1;
+  };
+  h += grasp_distance(m.moved, target_.rm, target_.gm);
+  if (target_.rb >= 0) h += grasp_distance(m.base, target_.rb, target_.gb);
+  if (target_.base_rests && s.loc[m.base] < 0) h += 1;
+  if (target_.base_moved && s.loc[m.base] == target_start_loc_) h += 2;
   return h;
 }
 
@@ -990,7 +1006,8 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
   // Flat lazy searches the whole task at once: only the memory limit bounds it.
   const long long max_nodes = limits.max_nodes > 0 ? limits.max_nodes : options_.max_nodes;
   const long long root_budget =
-      !m.flat ? max_nodes
+      target_.rm >= 0 ? std::min(max_nodes, kTargetNodes)
+      : !m.flat       ? max_nodes
               : window_.empty() ? (1LL << 62)
                                 : max_nodes * static_cast<long long>(window_.size());
   const long long local_budget = m.flat ? max_nodes : std::min(max_nodes, kLocalNodes);
@@ -1062,9 +1079,9 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
             tally_.Add(outcome.gate, outcome.message);
             failed_level_[edge] = outcome.permanent ? kPermanent : edge_level;
             if (++fill_failures_ > limits.max_failures) return SearchStatus::kExhausted;
-            // Optimistic: an assembly with the target's grasps that fails for good several
-            // times is a bad choice of target, not of the way there.
-            if (target_.rm >= 0 && a.type == ActionType::kAssemble && outcome.permanent &&
+            // Optimistic: an assembly with the target's grasps that fails several times is a
+            // bad choice of target, not of the way there.
+            if (target_.rm >= 0 && a.type == ActionType::kAssemble &&
                 ++target_failures >= kTargetFailures) {
               return SearchStatus::kExhausted;
             }
@@ -1107,7 +1124,7 @@ std::vector<TaskSearch::AssemblyTarget> TaskSearch::OptimisticTargets(const Mile
   // the wrench LP), without asking how the robots get there; the search then plans the picks,
   // handovers and set-downs to reach them. Grasps in set order (best spread first), robots
   // interleaved; per grasp the base resting where it is, else braced, else held in the air.
-  constexpr int kTargets = 8;
+  constexpr int kTargets = 16;
   SetClasses(m);
   target_start_loc_ = s0.loc[m.base];
   std::vector<AssemblyTarget> targets;

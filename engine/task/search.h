@@ -150,6 +150,8 @@ class TaskSearch {
   std::vector<AssemblyTarget> OptimisticTargets(const Milestone& m, const Resolution& res,
                                                 const SymState& s0);
   bool TargetAllows(const SymState& s, const Milestone& m) const;
+  /// Optimistic: the actions beyond counting that reaching the target's grasps needs.
+  int TargetDistance(const SymState& s, const Milestone& m);
   /// Points the grasp-class caches at milestone `m`'s inputs.
   void SetClasses(const Milestone& m);
   /// Estimated bytes held by the search (nodes, queue, caches), for the memory limit.
