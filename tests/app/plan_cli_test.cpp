@@ -36,7 +36,7 @@ TEST(PlanCli, PlansValidatesAndWritesThePlan) {
   for (const char* key : {"t_init_s", "t_grasp_s", "t_bwd_s", "t_lp_s", "t_fwd_s", "t_ik_s"}) {
     EXPECT_TRUE(plan["stats"].contains(key)) << key;
   }
-  EXPECT_EQ(plan["stats"]["planner"], "counting");
+  EXPECT_EQ(plan["stats"]["planner"], "wrap");  // the default
   EXPECT_EQ(plan["stats"]["seed"].get<int>(), 0);
   ASSERT_FALSE(plan["actions"].empty());
   EXPECT_TRUE(plan["actions"][0].contains("keyframe"));
@@ -56,11 +56,35 @@ TEST(PlanCli, SeedAndWrenchModeReachTheStats) {
   EXPECT_DOUBLE_EQ(plan["stats"]["force_scale"].get<double>(), 0.5);
 }
 
+// --optimize reports the improvement and records the cost over time; every variant is known.
+TEST(PlanCli, OptimizeRecordsTheCostOverTime) {
+  const fs::path dir = TempDir("optimize");
+  const fs::path out = dir / "plan.json";
+  const CliRun r = Wrap({"plan", Project("half_stool"), "-o", out.string(), "--optimize",
+                         "--time-limit", "20", "--planner", "counting", "--validate"});
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("Improved: cost "), std::string::npos) << r.out;
+  std::ifstream in(out);
+  const nlohmann::json plan = nlohmann::json::parse(in);
+  const nlohmann::json& st = plan["stats"];
+  EXPECT_EQ(st["planner"], "counting");
+  ASSERT_TRUE(st["cost_history"].is_array());
+  ASSERT_GE(st["cost_history"].size(), 1u);
+  EXPECT_EQ(st["cost_history"][0][1], st["first_cost"]);
+  EXPECT_EQ(st["cost_history"].back()[1], st["cost"]);
+  EXPECT_LE(st["cost"].get<int>(), st["first_cost"].get<int>());
+  for (const char* variant : {"optimistic", "flat", "exact", "fine"}) {
+    const CliRun v = Wrap({"plan", Project("half_stool"), "--planner", variant});
+    EXPECT_EQ(v.code, 0) << variant << ": " << v.out << v.err;
+  }
+}
+
 TEST(PlanCli, BadInputExitsTwo) {
   EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--wrench", "strong"}).code, 2);
   EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--force-scale", "-1"}).code, 2);
   EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--time-limit", "0"}).code, 2);
   EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--planner", "magic"}).code, 2);
+  EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--memory-limit", "0"}).code, 2);
   const CliRun missing = Wrap({"plan", "/nonexistent/project.json"});
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.err.find("project.json"), std::string::npos) << missing.err;
