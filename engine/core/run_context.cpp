@@ -1,5 +1,9 @@
 #include "core/run_context.h"
 
+#include <unistd.h>
+
+#include <cstdio>
+
 namespace wrap {
 
 void RunContext::set_time_limit_s(double seconds) {
@@ -9,6 +13,17 @@ void RunContext::set_time_limit_s(double seconds) {
   }
   deadline_ = Clock::now() +
               std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+std::size_t ResidentMemoryBytes() {
+  std::FILE* f = std::fopen("/proc/self/statm", "r");
+  if (!f) return 0;
+  unsigned long long size = 0, resident = 0;
+  const int n = std::fscanf(f, "%llu %llu", &size, &resident);
+  std::fclose(f);
+  if (n != 2) return 0;
+  const long page = sysconf(_SC_PAGESIZE);
+  return static_cast<std::size_t>(resident) * static_cast<std::size_t>(page > 0 ? page : 4096);
 }
 
 }  // namespace wrap

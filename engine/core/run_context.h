@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -75,5 +76,9 @@ class ScopedStageTimer {
   std::string stage_;
   RunContext::Clock::time_point start_;
 };
+
+/// The process's resident memory [bytes] (Linux: /proc/self/statm), 0 when unknown. For memory
+/// limits of long searches.
+std::size_t ResidentMemoryBytes();
 
 }  // namespace wrap

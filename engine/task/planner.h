@@ -40,8 +40,9 @@ struct TaskPlannerOptions {
   /// Anytime plan improvement after the first plan (large neighbourhood search) until the time
   /// limit of the RunContext or until windows of the whole horizon bring nothing more.
   bool optimize = false;
-  /// Memory the search may hold (nodes, queues, caches; estimated) [MiB]; beyond it the run
-  /// stops with "out of memory" in stats.failure.
+  /// Memory the search may hold [MiB]: its nodes, queues and caches (estimated) and the
+  /// process's growth since planning started (resident memory) must each stay below it; beyond
+  /// it the run stops with "out of memory" in stats.failure.
   long long memory_limit_mb = 4096;
   MatingWrenchMode wrench_mode = MatingWrenchMode::kFull;  ///< full, gravity or none.
   double force_scale = 1.0;      ///< Lambda on the mating force and torque, >= 0.

@@ -93,7 +93,8 @@ TaskSearch::TaskSearch(const TaskWorld& world, TaskTables& tables, KeyframeSolve
       fine_(options.planner == "fine"),
       flat_(options.planner == "flat"),
       optimistic_(options.planner == "optimistic"),
-      flat_order_(world.tree->step_order) {}
+      flat_order_(world.tree->step_order),
+      rss0_(ResidentMemoryBytes()) {}
 
 TaskSearch::Milestone TaskSearch::StepMilestone(int step, int next_step) const {
   Milestone m;
@@ -609,6 +610,12 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milesto
       if (ctx_.ShouldStop()) return SearchStatus::kStopped;
       if (MemoryBytes(open.size(), best_g.size()) > memory_limit) {
         return SearchStatus::kOutOfMemory;
+      }
+      // What the estimate misses (caches of the solver, the allocator's slack): the process's
+      // growth since the planner started.
+      if ((expansions_ & 4095) == 0) {
+        const std::size_t rss = ResidentMemoryBytes();
+        if (rss > rss0_ && rss - rss0_ > memory_limit) return SearchStatus::kOutOfMemory;
       }
     }
     const auto [f, neg_g, seq, index] = open.top();
