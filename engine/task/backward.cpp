@@ -40,8 +40,7 @@ bool TaskSearch::AssemblyGrasp(int input, int robot, int grasp) {
   auto& classes = backward_.assembly_grasp[input];
   if (auto it = classes.find(grasp); it != classes.end()) return it->second;
   const int other = input == 0 ? backward_.base : backward_.moved;
-  const bool ok =
-      solver_.GripperClear(robot, grasp, Iso3::Identity(), other, Iso3::Identity());
+  const bool ok = solver_.GripperClear(robot, grasp, Iso3::Identity(), other, Iso3::Identity());
   classes.emplace(grasp, ok);
   return ok;
 }
@@ -112,8 +111,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
     for (int r = 0; r < R; ++r) {
       for (int g : grasps(k, r)) {
         const int c = GraspClass(k, r, g);
-        if (b.loc0[k] >= 0 && !pick[k][idx_pick(0, r, c)] &&
-            CheapPick(r, nodes[k], b.loc0[k], g)) {
+        if (b.loc0[k] >= 0 && !pick[k][idx_pick(0, r, c)] && CheapPick(r, nodes[k], b.loc0[k], g)) {
           pick[k][idx_pick(0, r, c)] = 1;
         }
         for (int p = 0; p < b.n_place[k]; ++p) {
@@ -375,7 +373,8 @@ int TaskSearch::BackwardDistance(const SymState& s) {
     }
     int n = 0;
     for (int r = 0; r < n_robots_ && n < 2; ++r) {
-      if (s.held[r] == node) status[k][n++] = b.n_rest[k] + b.classes * r + GraspClass(k, r, s.grasp[r]);
+      if (s.held[r] == node)
+        status[k][n++] = b.n_rest[k] + b.classes * r + GraspClass(k, r, s.grasp[r]);
     }
     if (n == 0) return kFar;
   }

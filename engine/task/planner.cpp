@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cmath>
 #include <set>
 
 #include "robot/cell.h"
@@ -20,9 +20,12 @@ using Clock = std::chrono::steady_clock;
 
 std::string ModeName(MatingWrenchMode mode) {
   switch (mode) {
-    case MatingWrenchMode::kFull: return "full";
-    case MatingWrenchMode::kGravityOnly: return "gravity";
-    case MatingWrenchMode::kNone: return "none";
+    case MatingWrenchMode::kFull:
+      return "full";
+    case MatingWrenchMode::kGravityOnly:
+      return "gravity";
+    case MatingWrenchMode::kNone:
+      return "none";
   }
   return "?";
 }
@@ -44,9 +47,9 @@ int CostOf(const std::vector<MilestoneResult>& results, int from, int to) {
 // n milestones bounded by the window's cost (one milestone: the variant's heuristic; more: the
 // counting heuristic over the window), the milestones after it are refilled by the variant's
 // own fills (or kept, when the window ends in the incumbent's state) bounded so that the whole
-// plan is strictly cheaper;
-// a cheaper plan replaces the incumbent. n grows from 1 to the whole horizon; the search stops
-// early at the time limit or on cancellation. Returns false when it was stopped.
+// plan is strictly cheaper; a cheaper plan replaces the incumbent. n grows from 1 to the whole
+// horizon; the search stops early at the time limit or on cancellation. Returns false when it
+// was stopped.
 bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& s0,
              const ContState& c0, std::vector<MilestoneResult>& incumbent, RunContext& ctx,
              const Clock::time_point start, std::vector<std::pair<double, int>>& history) {
@@ -141,8 +144,8 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
 Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const Preprocessed& pre,
                       const TaskPlannerOptions& options, RunContext& ctx) {
   const auto start = Clock::now();
-  static const std::set<std::string> kVariants = {"wrap",  "optimistic", "flat",
-                                                   "counting", "exact", "fine"};
+  static const std::set<std::string> kVariants = {"wrap",     "optimistic", "flat",
+                                                  "counting", "exact",      "fine"};
   if (!kVariants.contains(options.planner)) {
     return Fail(ErrorCode::kInvalidInput,
                 "planner: unknown variant '" + options.planner +
@@ -152,8 +155,7 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
     return Fail(ErrorCode::kInvalidInput, "planner: --force-scale must be finite and >= 0");
   }
   if (options.max_effort < 0 || options.max_effort > 2 || options.max_holders < 1 ||
-      options.max_nodes < 100 || !(options.min_clearance_m >= 0.0) ||
-      options.memory_limit_mb < 1) {
+      options.max_nodes < 100 || !(options.min_clearance_m >= 0.0) || options.memory_limit_mb < 1) {
     return Fail(ErrorCode::kInvalidInput, "planner: options out of range");
   }
   auto world_or = BuildTaskWorld(project, check, pre, options.project_file);
@@ -206,16 +208,16 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   bool stopped = false;
   bool out_of_memory = false;
   while (k < K) {
-    const std::string words = flat ? "the whole task (flat)"
-                                   : "milestone " + std::to_string(k + 1) + "/" +
-                                         std::to_string(K) + " '" +
-                                         world.tree->nodes[order[k]].name + "'";
+    const std::string words = flat
+                                  ? "the whole task (flat)"
+                                  : "milestone " + std::to_string(k + 1) + "/" + std::to_string(K) +
+                                        " '" + world.tree->nodes[order[k]].name + "'";
     ctx.Progress("task", static_cast<double>(k) / std::max(1, K), words);
     const SymState& s = k == 0 ? s0 : results[k - 1].end;
     const ContState& c = k == 0 ? c0 : results[k - 1].end_c;
-    MilestoneResult r = flat ? search.FillFlat(s0, c0)
-                             : search.Fill(k, order[k], k + 1 < K ? order[k + 1] : -1, s, c,
-                                           excluded[k]);
+    MilestoneResult r =
+        flat ? search.FillFlat(s0, c0)
+             : search.Fill(k, order[k], k + 1 < K ? order[k + 1] : -1, s, c, excluded[k]);
     if (r.ok) {
       if (flat) {
         results[0] = std::move(r);
@@ -276,8 +278,8 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   st.t_lp_s = counters.t_lp_s;
   // The backward abstraction's own LP and IK questions count in t_lp and t_ik as well.
   st.t_bwd_s = search.backward_seconds();
-  st.t_fwd_s = std::max(0.0, search.search_seconds() - st.t_bwd_s - counters.t_ik_s -
-                                 counters.t_lp_s);
+  st.t_fwd_s =
+      std::max(0.0, search.search_seconds() - st.t_bwd_s - counters.t_ik_s - counters.t_lp_s);
   st.milestones = K;
   st.backtracks = backtracks;
   st.widenings = search.widenings();

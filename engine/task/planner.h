@@ -10,11 +10,14 @@
 // revisited at the next; grasp and placement subsets are widened when a milestone fails; a
 // milestone that fails makes the previous one look for another end state (backtracking).
 //
-// "wrap" (the default) replaces the counting heuristic by WRAP's backward abstract heuristic (search.h,
-// backward.cpp): per milestone a breadth-first search backwards from the assembly over the two
-// inputs' projected status (resting where they start or in a placement; held by a robot with an
-// assembly grasp or another one); "exact" is the paper's "exact fills": the same with f = g + h
-// instead of f = g + 2 h.
+// "wrap" (the default) replaces the counting heuristic by WRAP's backward abstract heuristic
+// (search.h, backward.cpp): per milestone a breadth-first search backwards from the assembly over
+// the two inputs' projected status (resting where they start or in a placement; held by a robot
+// with an assembly grasp or another one); "exact" is the paper's "exact fills": the same with
+// f = g + h instead of f = g + 2 h; "fine" splits the abstraction's grasp classes by approach
+// direction. "optimistic" (like Dogar et al.) chooses the assembly's grasps first and searches for
+// a way to them; "flat" ("Flat lazy") searches the whole task at once (variants.cpp). With
+// `optimize`, windows of milestones are searched again for a cheaper plan until the time limit.
 #pragma once
 
 #include <filesystem>
@@ -45,15 +48,15 @@ struct TaskPlannerOptions {
   /// it the run stops with "out of memory" in stats.failure.
   long long memory_limit_mb = 4096;
   MatingWrenchMode wrench_mode = MatingWrenchMode::kFull;  ///< full, gravity or none.
-  double force_scale = 1.0;      ///< Lambda on the mating force and torque, >= 0.
+  double force_scale = 1.0;        ///< Lambda on the mating force and torque, >= 0.
   double min_clearance_m = 0.005;  ///< Least distance between two robots at a keyframe [m].
-  int max_effort = 2;            ///< Highest effort level (0-based) of the IK and pose sampling.
+  int max_effort = 2;              ///< Highest effort level (0-based) of the IK and pose sampling.
   /// Widen the grasp and placement subsets when a milestone fails; absent: the project's
   /// `planner.widen_grasps`.
   std::optional<bool> widen;
-  int max_holders = 2;           ///< Most robots holding one object at once.
-  long long max_nodes = 400000;  ///< Search nodes kept per milestone search (memory bound).
-  int max_backtracks = 6;        ///< Milestone re-plans after later milestones failed.
+  int max_holders = 2;                 ///< Most robots holding one object at once.
+  long long max_nodes = 400000;        ///< Search nodes kept per milestone search (memory bound).
+  int max_backtracks = 6;              ///< Milestone re-plans after later milestones failed.
   std::filesystem::path project_file;  ///< Resolves URDF robots; may be empty.
 };
 

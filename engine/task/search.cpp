@@ -1,10 +1,10 @@
 #include "task/search.h"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <climits>
+#include <cstdio>
+#include <cstdlib>
 #include <queue>
 #include <tuple>
 #include <unordered_set>
@@ -68,8 +68,8 @@ std::string GateTally::Summary(int max_gates) const {
   for (int k = 0; k < static_cast<int>(order.size()) && k < max_gates; ++k) {
     const int i = order[k];
     if (!out.empty()) out += "; ";
-    out += std::string(GateName(static_cast<Gate>(i))) + " failed " + std::to_string(count[i]) +
-           "x";
+    out +=
+        std::string(GateName(static_cast<Gate>(i))) + " failed " + std::to_string(count[i]) + "x";
     if (!example[i].empty()) out += " (e.g. " + example[i] + ")";
   }
   return out.empty() ? "no candidate action passed the cheap checks" : out;
@@ -178,7 +178,8 @@ int TaskSearch::Heuristic(const SymState& s, const Milestone& m) {
     // rests on the table, a pick; a release per object held that no step still needs.
     const int done = WindowDone(s);
     const int n = static_cast<int>(window_.size());
-    for (int t = done; t < n; ++t) h += 1 + (s.loc[world_.interface(window_[t]).moved] >= 0 ? 1 : 0);
+    for (int t = done; t < n; ++t)
+      h += 1 + (s.loc[world_.interface(window_[t]).moved] >= 0 ? 1 : 0);
     for (int r = 0; r < n_robots_; ++r) {
       const int o = s.held[r];
       if (o < 0 || o == m.keep[0] || o == m.keep[1]) continue;
@@ -300,9 +301,10 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
   const Iso3 X_WA = tables_.location(loc).X_WA;
   const Iso3 target = solver_.GraspTarget(X_WA, grasp);
   bool ok = solver_.InReach(robot, target);
-  if (!ok) tally_.Add(Gate::kReach, "'" + world_.robots[robot].name + "' cannot reach grasp " +
-                                        std::to_string(tables_.grasp(grasp).index) + " of '" +
-                                        world_.tree->nodes[node].name + "' where it rests");
+  if (!ok)
+    tally_.Add(Gate::kReach, "'" + world_.robots[robot].name + "' cannot reach grasp " +
+                                 std::to_string(tables_.grasp(grasp).index) + " of '" +
+                                 world_.tree->nodes[node].name + "' where it rests");
   if (ok && !solver_.ClearOfTable(robot, target, solver_.GraspOpening(grasp))) {
     ok = false;
     tally_.Add(Gate::kCollision, "grasp " + std::to_string(tables_.grasp(grasp).index) + " of '" +
@@ -339,13 +341,14 @@ bool TaskSearch::CheapPlace(int robot, int node, int loc, int grasp) {
   const Iso3 X_WA = tables_.location(loc).X_WA;
   const Iso3 target = solver_.GraspTarget(X_WA, grasp);
   bool ok = solver_.InReach(robot, target);
-  if (!ok) tally_.Add(Gate::kReach, "'" + world_.robots[robot].name + "' cannot reach to set '" +
-                                        world_.tree->nodes[node].name + "' down there");
+  if (!ok)
+    tally_.Add(Gate::kReach, "'" + world_.robots[robot].name + "' cannot reach to set '" +
+                                 world_.tree->nodes[node].name + "' down there");
   if (ok && !solver_.ClearOfTable(robot, target, solver_.GraspOpening(grasp))) {
     ok = false;
-    tally_.Add(Gate::kCollision, "setting '" + world_.tree->nodes[node].name + "' down with grasp " +
-                                     std::to_string(tables_.grasp(grasp).index) +
-                                     " puts the gripper into the table");
+    tally_.Add(Gate::kCollision,
+               "setting '" + world_.tree->nodes[node].name + "' down with grasp " +
+                   std::to_string(tables_.grasp(grasp).index) + " puts the gripper into the table");
   }
   if (ok && !HomesClear(node, loc)) {
     ok = false;
@@ -418,7 +421,8 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
       if (!ok) break;
       std::string solo;
       ok = solver_.SoloReach(r, {{m.moved, X_WB, m_touches}, {m.base, X_WB, true}}, g, &solo);
-      if (!ok) tally_.Add(Gate::kIk, solo + " to insert '" + world_.tree->nodes[m.moved].name + "'");
+      if (!ok)
+        tally_.Add(Gate::kIk, solo + " to insert '" + world_.tree->nodes[m.moved].name + "'");
     }
     if (ok && !solver_.ClearOfHomes(m.step, X_WB)) {
       ok = false;
@@ -551,8 +555,8 @@ void TaskSearch::Successors(const SymState& s, const Milestone& m, const Resolut
           if (n == o || s.loc[n] < 0) continue;
           const Aabb& box_n = world_.pre->subassemblies[n].aabb_A;
           const double r_n = 0.5 * (box_n.max - box_n.min).head<2>().norm();
-          const Vec3 c_n = tables_.location(s.loc[n]).X_WA *
-                           Vec3(world_.pre->subassemblies[n].com_A);
+          const Vec3 c_n =
+              tables_.location(s.loc[n]).X_WA * Vec3(world_.pre->subassemblies[n].com_A);
           if ((c_n - slot.p_W).head<2>().norm() < r_o + r_n) free = false;
         }
         if (!free) continue;
@@ -586,13 +590,12 @@ void TaskSearch::Successors(const SymState& s, const Milestone& m, const Resolut
   }
 }
 
-TaskSearch::SearchStatus TaskSearch::BestFirst(const SymState& s0, const Milestone& m,
-                                               const Resolution& res, int effort,
-                                               const std::set<std::uint64_t>& excluded,
-                                               const std::unordered_map<std::uint64_t, bool>& dead_ends,
-                                               const std::unordered_set<std::uint64_t>& forbidden,
-                                               long long node_budget, int g0, int max_cost,
-                                               std::vector<int>& path) {
+TaskSearch::SearchStatus TaskSearch::BestFirst(
+    const SymState& s0, const Milestone& m, const Resolution& res, int effort,
+    const std::set<std::uint64_t>& excluded,
+    const std::unordered_map<std::uint64_t, bool>& dead_ends,
+    const std::unordered_set<std::uint64_t>& forbidden, long long node_budget, int g0, int max_cost,
+    std::vector<int>& path) {
   nodes_.clear();
   std::unordered_map<std::uint64_t, int> best_g;
   using Entry = std::tuple<int, int, long long, int>;  // f, -g, sequence, node
@@ -811,7 +814,8 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   if (std::string why; !AssemblyPossible(m, &why)) {
     result.failure = words +
                      ": no combination of grasps and supports balances the mating wrench, "
-                     "whatever the robots' reach: " + why;
+                     "whatever the robots' reach: " +
+                     why;
     return result;
   }
   const int levels = 3;
@@ -856,11 +860,11 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
     if (level + 1 < levels) ++widenings_;
   }
   finish();
-  result.failure = words + ": no plan with every grasp, placement and effort level" +
-                   (limits.max_cost < (1 << 30) ? " within " + std::to_string(limits.max_cost) +
-                                                      " actions"
-                                                : std::string()) +
-                   "; " + (abstract_failure.empty() ? tally_.Summary() : abstract_failure);
+  result.failure =
+      words + ": no plan with every grasp, placement and effort level" +
+      (limits.max_cost < (1 << 30) ? " within " + std::to_string(limits.max_cost) + " actions"
+                                   : std::string()) +
+      "; " + (abstract_failure.empty() ? tally_.Summary() : abstract_failure);
   return result;
 }
 
@@ -885,17 +889,16 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
   };
   const int max_actions =
       std::min(limits.max_cost,
-               m.flat ? kMaxMilestoneActions * static_cast<int>(window_.empty()
-                                                                    ? flat_order_.size()
-                                                                    : window_.size())
+               m.flat ? kMaxMilestoneActions *
+                            static_cast<int>(window_.empty() ? flat_order_.size() : window_.size())
                       : kMaxMilestoneActions);
   // Flat lazy searches the whole task at once: only the memory limit bounds it.
   const long long max_nodes = limits.max_nodes > 0 ? limits.max_nodes : options_.max_nodes;
-  const long long root_budget =
-      target_.rm >= 0 ? std::min(max_nodes, kTargetNodes)
-      : !m.flat       ? max_nodes
-              : window_.empty() ? (1LL << 62)
-                                : max_nodes * static_cast<long long>(window_.size());
+  const long long root_budget = target_.rm >= 0 ? std::min(max_nodes, kTargetNodes)
+                                : !m.flat       ? max_nodes
+                                : window_.empty()
+                                    ? (1LL << 62)
+                                    : max_nodes * static_cast<long long>(window_.size());
   const long long local_budget = m.flat ? max_nodes : std::min(max_nodes, kLocalNodes);
   auto stop = [&](SearchStatus status) {
     result.stopped = status == SearchStatus::kStopped;
@@ -928,8 +931,7 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
       if (status == SearchStatus::kStopped || status == SearchStatus::kOutOfMemory) {
         return stop(status);
       }
-      if (status == SearchStatus::kFound &&
-          g0 + static_cast<int>(path.size()) > max_actions) {
+      if (status == SearchStatus::kFound && g0 + static_cast<int>(path.size()) > max_actions) {
         status = SearchStatus::kExhausted;  // too long: treat as a dead end
       }
       if (status != SearchStatus::kFound) {
@@ -991,7 +993,8 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
         result.ok = true;
         result.actions = std::move(actions);
         result.after.clear();
-        for (size_t i = 1; i < prefix.size(); ++i) result.after.push_back({prefix[i].s, prefix[i].c});
+        for (size_t i = 1; i < prefix.size(); ++i)
+          result.after.push_back({prefix[i].s, prefix[i].c});
         result.end = prefix.back().s;
         result.end_c = prefix.back().c;
         return SearchStatus::kFound;

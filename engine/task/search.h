@@ -6,8 +6,8 @@
 
 #include <array>
 #include <cstdint>
-#include <optional>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <unordered_map>
@@ -36,14 +36,14 @@ struct GateTally {
 /// One milestone's answer.
 struct MilestoneResult {
   bool ok = false;
-  bool stopped = false;              ///< Cancelled or out of time.
-  std::vector<PlanAction> actions;   ///< The validated actions.
+  bool stopped = false;             ///< Cancelled or out of time.
+  std::vector<PlanAction> actions;  ///< The validated actions.
   /// The state after each action (plan improvement splits a window's actions by milestone).
   std::vector<std::pair<SymState, ContState>> after;
-  SymState end;                      ///< Symbolic state at its end.
-  ContState end_c;                   ///< Continuous state at its end.
-  bool out_of_memory = false;        ///< Stopped by TaskPlannerOptions::memory_limit_mb.
-  std::string failure;               ///< Why not, when !ok.
+  SymState end;                ///< Symbolic state at its end.
+  ContState end_c;             ///< Continuous state at its end.
+  bool out_of_memory = false;  ///< Stopped by TaskPlannerOptions::memory_limit_mb.
+  std::string failure;         ///< Why not, when !ok.
 };
 
 /// Limits of one fill beyond the variant's own, for plan improvement.
@@ -105,8 +105,8 @@ class TaskSearch {
   /// Optimistic (Dogar et al.): the assembly's grasps chosen before the search; the search must
   /// assemble with them. rm < 0: any.
   struct AssemblyTarget {
-    int rm = -1, gm = -1;  ///< Robot and grasp id holding the moved input.
-    int rb = -1, gb = -1;  ///< Robot and grasp id holding (or bracing) the base; rb < 0: none.
+    int rm = -1, gm = -1;     ///< Robot and grasp id holding the moved input.
+    int rb = -1, gb = -1;     ///< Robot and grasp id holding (or bracing) the base; rb < 0: none.
     bool base_rests = false;  ///< The base rests on the table (braced when rb >= 0) ...
     bool base_moved = false;  ///< ... not where it rested at the milestone's start.
   };
@@ -160,8 +160,8 @@ class TaskSearch {
   SearchStatus BestFirst(const SymState& s0, const Milestone& m, const Resolution& res, int effort,
                          const std::set<std::uint64_t>& excluded,
                          const std::unordered_map<std::uint64_t, bool>& dead_ends,
-                         const std::unordered_set<std::uint64_t>& forbidden,
-                         long long node_budget, int g0, int max_cost, std::vector<int>& path);
+                         const std::unordered_set<std::uint64_t>& forbidden, long long node_budget,
+                         int g0, int max_cost, std::vector<int>& path);
   bool CheapPick(int robot, int node, int loc, int grasp);
   bool CheapPlace(int robot, int node, int loc, int grasp);
   bool CheapAssemble(const SymState& s, const Milestone& m);
@@ -184,8 +184,8 @@ class TaskSearch {
     int n_status[2] = {0, 0};  ///< Rest statuses, then (robot, grasp class) pairs.
     int classes = 2;           ///< Grasp classes: 2, or 12 for the fine projection.
     std::unordered_map<int, bool> assembly_grasp[2];  ///< Grasp id -> assembly class.
-    std::vector<int> dist;     ///< Per (moved status, base status): actions to the assembly.
-    std::string why;           ///< Why the start is kFarDistance away (empty otherwise).
+    std::vector<int> dist;  ///< Per (moved status, base status): actions to the assembly.
+    std::string why;        ///< Why the start is kFarDistance away (empty otherwise).
   };
   Backward backward_;
 
@@ -197,14 +197,14 @@ class TaskSearch {
   std::uint64_t seed_;
   bool widen_;
   int n_robots_ = 0;
-  bool use_backward_ = false;  ///< wrap, exact: the backward heuristic replaces counting.
-  int default_weight_ = 2;     ///< f = g + weight h: 2 (weighted best-first), 1 for "exact".
-  int weight_ = 2;             ///< This fill's weight.
-  bool fine_ = false;          ///< "fine": the backward abstraction's classes split by direction.
-  bool flat_ = false;          ///< "flat": FillFlat instead of milestones.
-  bool optimistic_ = false;    ///< "optimistic": assembly targets chosen first.
-  AssemblyTarget target_;      ///< The current optimistic target.
-  int target_start_loc_ = -1;  ///< Where the base rested at the target's milestone start.
+  bool use_backward_ = false;    ///< wrap, exact: the backward heuristic replaces counting.
+  int default_weight_ = 2;       ///< f = g + weight h: 2 (weighted best-first), 1 for "exact".
+  int weight_ = 2;               ///< This fill's weight.
+  bool fine_ = false;            ///< "fine": the backward abstraction's classes split by direction.
+  bool flat_ = false;            ///< "flat": FillFlat instead of milestones.
+  bool optimistic_ = false;      ///< "optimistic": assembly targets chosen first.
+  AssemblyTarget target_;        ///< The current optimistic target.
+  int target_start_loc_ = -1;    ///< Where the base rested at the target's milestone start.
   std::vector<int> flat_order_;  ///< Steps in the DAG's topological order.
   std::vector<int> window_;      ///< FillWindow's steps (empty: FillFlat's whole task).
   int window_next_ = -1;         ///< The step after the window (-1: none).
@@ -214,7 +214,7 @@ class TaskSearch {
   int WindowDone(const SymState& s) const;
   std::vector<Node> nodes_;
   std::map<std::pair<int, int>, std::vector<int>> grasp_ids_;
-  std::unordered_map<std::uint64_t, int> failed_level_;   // edge key -> level failed at
+  std::unordered_map<std::uint64_t, int> failed_level_;       // edge key -> level failed at
   std::unordered_map<std::uint64_t, EdgeOutcome> witnesses_;  // continuous edge key -> outcome
   struct CheapAnswer {
     bool ok = true;
@@ -222,12 +222,12 @@ class TaskSearch {
     std::string why;
   };
   bool Recall(std::uint64_t key, const CheapAnswer& answer);  // tallies a cached failure once
-  void Remember(std::uint64_t key, bool ok);  // caches with the last tallied reason
-  std::unordered_map<std::uint64_t, CheapAnswer> cheap_;  // cheap-check answers
-  std::unordered_set<std::uint64_t> tallied_;  // cheap failures tallied in this milestone
+  void Remember(std::uint64_t key, bool ok);                  // caches with the last tallied reason
+  std::unordered_map<std::uint64_t, CheapAnswer> cheap_;      // cheap-check answers
+  std::unordered_set<std::uint64_t> tallied_;            // cheap failures tallied in this milestone
   std::unordered_map<std::uint64_t, bool> homes_clear_;  // HomesClear per (node, location)
   std::map<int, std::pair<bool, std::string>> possible_;  // AssemblyPossible per step
-  std::vector<Iso3> placement_pose_;                       // scratch
+  std::vector<Iso3> placement_pose_;                      // scratch
   long long expansions_ = 0;
   int widenings_ = 0;
   double search_s_ = 0.0;

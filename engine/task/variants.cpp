@@ -119,7 +119,8 @@ MilestoneResult TaskSearch::FillFlat(const SymState& s0, const ContState& c0) {
     if (std::string why; !AssemblyPossible(StepMilestone(step, -1), &why)) {
       result.failure = "step " + StepWords(step) +
                        ": no combination of grasps and supports balances the mating wrench, "
-                       "whatever the robots' reach: " + why;
+                       "whatever the robots' reach: " +
+                       why;
       return result;
     }
   }
@@ -131,8 +132,10 @@ MilestoneResult TaskSearch::FillFlat(const SymState& s0, const ContState& c0) {
   }
   search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
   if (!result.ok && !result.stopped && !result.out_of_memory) {
-    result.failure = "the whole task (flat, no milestones): no plan with every grasp, placement "
-                     "and effort level; " + tally_.Summary();
+    result.failure =
+        "the whole task (flat, no milestones): no plan with every grasp, placement "
+        "and effort level; " +
+        tally_.Summary();
   }
   return result;
 }

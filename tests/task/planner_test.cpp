@@ -74,10 +74,9 @@ TEST_P(ExamplePlan, IsSolvedAndValid) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Projects, ExamplePlan,
-                         ::testing::Values("stool", "half_stool", "chair", "cross",
-                                           "cross_openarm", "cube", "cube_2x2x3",
-                                           "fabrica_plumbers_block", "fabrica_beam",
-                                           "fabrica_car"),
+                         ::testing::Values("stool", "half_stool", "chair", "cross", "cross_openarm",
+                                           "cube", "cube_2x2x3", "fabrica_plumbers_block",
+                                           "fabrica_beam", "fabrica_car"),
                          [](const auto& param_info) { return param_info.param; });
 
 // When the backward abstraction cannot reach a step's assembly, WRAP says why at once instead of
@@ -131,8 +130,9 @@ TEST_P(CrossRobots, IsSolvedAndValid) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Counts, CrossRobots, ::testing::Values(2, 3),
-                         [](const auto& param_info) { return std::to_string(param_info.param) + "_robots"; });
+INSTANTIATE_TEST_SUITE_P(Counts, CrossRobots, ::testing::Values(2, 3), [](const auto& param_info) {
+  return std::to_string(param_info.param) + "_robots";
+});
 
 // Same project, options and seed: the same plan, keyframes included.
 TEST(PlannerDeterminism, SameSeedSamePlan) {

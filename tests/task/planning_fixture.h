@@ -34,9 +34,9 @@ struct PlanRun {
 };
 
 // Preprocesses and plans `project` (already loaded and checked), then validates the plan.
-inline PlanRun PlanAndValidate(const Project& project, const ProjectCheck& check, const fs::path& file,
-                    std::uint64_t seed, double time_limit_s,
-                    const TaskPlannerOptions& base_options = {}) {
+inline PlanRun PlanAndValidate(const Project& project, const ProjectCheck& check,
+                               const fs::path& file, std::uint64_t seed, double time_limit_s,
+                               const TaskPlannerOptions& base_options = {}) {
   PlanRun run;
   RunContext ctx(seed);
   ctx.set_time_limit_s(time_limit_s);
