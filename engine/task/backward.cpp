@@ -148,7 +148,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
           const int c1 = GraspClass(k, r1, g1);
           for (int g2 : grasps(k, r2)) {
             const int c2 = GraspClass(k, r2, g2);
-            if (!apart[c1 * nc + c2] && GraspsApart(g1, g2)) apart[c1 * nc + c2] = 1;
+            if (!apart[c1 * nc + c2] && HandsApart(r1, g1, r2, g2)) apart[c1 * nc + c2] = 1;
           }
         }
         for (int c = 0; c < nc * nc; ++c) hand[k][idx_hand(r1, c / nc, r2, c % nc)] = apart[c];

@@ -1,10 +1,10 @@
 #include "task/keyframes.h"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <numbers>
 
@@ -35,7 +35,7 @@ Mat3 RandomRotation(std::mt19937_64& rng) {
 constexpr int kAirSamples[] = {6, 16, 40};
 constexpr int kAssemblySamples[] = {10, 25, 60};
 constexpr int kNumericRestarts[] = {3, 10, 25};
-constexpr int kMaxLeaves = 24;           // IK combinations tried per pose candidate
+constexpr int kMaxLeaves = 24;  // IK combinations tried per pose candidate
 constexpr int kMaxSolutionsPerRobot = 8;
 constexpr double kTouchTolerance = 2e-3;  // an object this close above the table rests on it
 
@@ -43,24 +43,34 @@ constexpr double kTouchTolerance = 2e-3;  // an object this close above the tabl
 
 std::string_view GateName(Gate gate) {
   switch (gate) {
-    case Gate::kNone: return "none";
-    case Gate::kReach: return "out of reach";
-    case Gate::kIk: return "IK";
-    case Gate::kCollision: return "collision";
-    case Gate::kClearance: return "robot clearance";
-    case Gate::kApproach: return "insertion approach";
-    case Gate::kTable: return "below the table";
-    case Gate::kWrenchAssembly: return "wrench (assembly)";
-    case Gate::kWrenchTransport: return "wrench (transport)";
-    case Gate::kWrenchRelease: return "wrench (release)";
-    case Gate::kWrenchRest: return "wrench (rest)";
+    case Gate::kNone:
+      return "none";
+    case Gate::kReach:
+      return "out of reach";
+    case Gate::kIk:
+      return "IK";
+    case Gate::kCollision:
+      return "collision";
+    case Gate::kClearance:
+      return "robot clearance";
+    case Gate::kApproach:
+      return "insertion approach";
+    case Gate::kTable:
+      return "below the table";
+    case Gate::kWrenchAssembly:
+      return "wrench (assembly)";
+    case Gate::kWrenchTransport:
+      return "wrench (transport)";
+    case Gate::kWrenchRelease:
+      return "wrench (release)";
+    case Gate::kWrenchRest:
+      return "wrench (rest)";
   }
   return "?";
 }
 
 KeyframeSolver::KeyframeSolver(const TaskWorld& world, TaskTables& tables,
-                               const TaskPlannerOptions& options, Cell cell,
-                               TaskCounters& counters)
+                               const TaskPlannerOptions& options, Cell cell, TaskCounters& counters)
     : world_(world),
       tables_(tables),
       options_(options),
@@ -88,13 +98,14 @@ KeyframeSolver::KeyframeSolver(const TaskWorld& world, TaskTables& tables,
       f.X_FS0[k] = shape.X_LS;
       f.per_metre[k] = Vec3::Zero();
       if (ee.stroke_m > 0.0) {
-        f.per_metre[k] = (open[ee.finger_shapes[k]].X_LS.translation() -
-                          shape.X_LS.translation()) / ee.stroke_m;
+        f.per_metre[k] =
+            (open[ee.finger_shapes[k]].X_LS.translation() - shape.X_LS.translation()) / ee.stroke_m;
       }
       Shape box = shape;
       box.X_LS = Iso3::Identity();
       auto body = w.AddBody(BodyDef{world.robots[r].name + "/finger_" + std::to_string(k),
-                                    CellEndEffectorGroup(static_cast<int>(r)), {box},
+                                    CellEndEffectorGroup(static_cast<int>(r)),
+                                    {box},
                                     Iso3::Identity()});
       if (!body) continue;
       f.body[k] = *body;
@@ -131,6 +142,34 @@ bool KeyframeSolver::GripperClear(int robot, int grasp, const Iso3& X_WA, int ot
   }
   // Every validation sets the robots and the scene again before it checks anything.
   return !hit;
+}
+
+bool KeyframeSolver::GrippersApart(int robot_a, int grasp_a, int robot_b, int grasp_b) {
+  ++counters_.collision_checks;
+  CollisionWorld& w = cell_.world();
+  std::vector<BodyId> bodies[2];
+  const int robots[2] = {robot_a, robot_b};
+  const int grasps[2] = {grasp_a, grasp_b};
+  for (int k = 0; k < 2; ++k) {
+    const TaskRobot& r = world_.robots[robots[k]];
+    const Iso3 X_WF = GraspTarget(Iso3::Identity(), grasps[k]) * r.end_effector.X_FT.inverse();
+    bodies[k].push_back(cell_.end_effector_body(robots[k]));
+    w.SetPose(bodies[k][0], X_WF);
+    if (fingers_[robots[k]]) {
+      opening_[robots[k]] = GraspOpening(grasps[k]);
+      PlaceFingers(robots[k], X_WF);
+      for (int f = 0; f < 2; ++f) bodies[k].push_back(fingers_[robots[k]]->body[f]);
+    }
+  }
+  CollisionRequest request;
+  request.margin_m = options_.min_clearance_m;
+  for (BodyId a : bodies[0]) {
+    for (BodyId b : bodies[1]) {
+      if (w.Collide(a, b, request)) return false;
+    }
+  }
+  // Every validation sets the robots and the scene again before it checks anything.
+  return true;
 }
 
 bool KeyframeSolver::ClearOfHomes(int node, const Iso3& X_WA) {
@@ -192,7 +231,8 @@ bool KeyframeSolver::ClearOfTable(int robot, const Iso3& X_WT, double opening_m)
   if (fingers_[robot]) {
     opening_[robot] = opening_m < 0.0 ? fingers_[robot]->stroke : opening_m;
     PlaceFingers(robot, X_WF);
-    for (int k = 0; k < 2 && !hit; ++k) hit = w.Collide(fingers_[robot]->body[k], cell_.table_body());
+    for (int k = 0; k < 2 && !hit; ++k)
+      hit = w.Collide(fingers_[robot]->body[k], cell_.table_body());
     opening_[robot] = saved_opening;
     PlaceFingers(robot, saved);
   }
@@ -209,8 +249,9 @@ bool KeyframeSolver::SoloReach(int robot, const std::vector<PlanObject>& objects
   const TaskRobot& r = world_.robots[robot];
   bool ok = SolveIk(robot, target, r.home, r.ur ? 0 : 1, rng, sols);
   if (!ok) {
-    if (why) *why = "no IK solution for '" + r.name + "' at grasp " +
-                    std::to_string(tables_.grasp(grasp).index);
+    if (why)
+      *why = "no IK solution for '" + r.name + "' at grasp " +
+             std::to_string(tables_.grasp(grasp).index);
   } else {
     SetScene(objects, {{robot, grasp}}, objects.size() > 1 ? objects[0].node : -1,
              objects.size() > 1 ? objects[1].node : -1);
@@ -233,9 +274,8 @@ bool KeyframeSolver::SoloReach(int robot, const std::vector<PlanObject>& objects
   return ok;
 }
 
-
-bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objects,
-                            int mating_step, std::uint64_t key, std::string* reason) {
+bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objects, int mating_step,
+                            std::uint64_t key, std::string* reason) {
   if (options_.wrench_mode == MatingWrenchMode::kNone) return true;
   ++counters_.lp_checks;
   const auto start = Clock::now();
@@ -244,8 +284,8 @@ bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objec
   query.gate = gate;
   query.mode = options_.wrench_mode;
   query.lambda = options_.force_scale;
-  auto result = key != 0 ? checker_.CheckCached(key, config, query)
-                         : checker_.CheckCached(config, query);
+  auto result =
+      key != 0 ? checker_.CheckCached(key, config, query) : checker_.CheckCached(config, query);
   counters_.t_lp_s += Seconds(start);
   if (!result) {
     if (reason) *reason = result.error().message;
@@ -257,8 +297,8 @@ bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objec
 
 std::vector<Mat3> KeyframeSolver::AxisOrientations(const Vec3& axis_A) {
   std::vector<Mat3> out;
-  const Vec3 dirs[] = {-Vec3::UnitZ(), Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(),
-                       -Vec3::UnitY(), Vec3::UnitZ()};
+  const Vec3 dirs[] = {-Vec3::UnitZ(), Vec3::UnitX(),  -Vec3::UnitX(),
+                       Vec3::UnitY(),  -Vec3::UnitY(), Vec3::UnitZ()};
   for (const Vec3& d : dirs) {
     const Mat3 align = RotationBetween(axis_A.normalized(), d);
     for (int k = 0; k < 4; ++k) {
@@ -358,9 +398,9 @@ void KeyframeSolver::SetScene(const std::vector<PlanObject>& objects,
   const BodyId table = cell_.table_body();
   std::vector<char> touching(objects.size(), 0);
   for (size_t i = 0; i < objects.size(); ++i) {
-    touching[i] = !objects[i].resting &&
-                  std::abs(LowestPoint(world_, objects[i].node, objects[i].X_WA) -
-                           world_.table_top) <= kTouchTolerance;
+    touching[i] =
+        !objects[i].resting && std::abs(LowestPoint(world_, objects[i].node, objects[i].X_WA) -
+                                        world_.table_top) <= kTouchTolerance;
   }
   for (int p = 0; p < world_.num_parts; ++p) {
     const BodyId body = cell_.object_body(p);
@@ -452,14 +492,14 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
 
   // The problem, filled per action type.
   std::vector<Mover> movers;
-  std::vector<int> reposed;         // nodes whose pose is sampled
+  std::vector<int> reposed;  // nodes whose pose is sampled
   int n_candidates = 1;
   std::function<bool(int, std::vector<Iso3>&)> make;  // candidate poses (node-indexed)
   std::function<bool(const std::vector<Iso3>&, Gate&, std::string&)> gates;
   std::vector<int> keyframe_nodes;  // objects listed in the keyframe
   std::vector<bool> keyframe_resting(world_.num_nodes, false);
-  int allow_a = -1, allow_b = -1;   // mated pair at the keyframe (assemble)
-  std::vector<int> freed;           // robots that go home after the action
+  int allow_a = -1, allow_b = -1;  // mated pair at the keyframe (assemble)
+  std::vector<int> freed;          // robots that go home after the action
   std::vector<std::pair<int, int>> holds_at_keyframe;
   for (int r = 0; r < n_robots; ++r) {
     if (s.held[r] >= 0) holds_at_keyframe.push_back({r, s.grasp[r]});
@@ -665,17 +705,25 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
     // Keep the most advanced failure: wrench < IK < collision < clearance < approach.
     auto rank = [](Gate x) {
       switch (x) {
-        case Gate::kNone: return 0;
-        case Gate::kTable: return 1;
+        case Gate::kNone:
+          return 0;
+        case Gate::kTable:
+          return 1;
         case Gate::kWrenchTransport:
         case Gate::kWrenchRelease:
         case Gate::kWrenchRest:
-        case Gate::kWrenchAssembly: return 2;
-        case Gate::kReach: return 3;
-        case Gate::kIk: return 4;
-        case Gate::kCollision: return 5;
-        case Gate::kClearance: return 6;
-        case Gate::kApproach: return 7;
+        case Gate::kWrenchAssembly:
+          return 2;
+        case Gate::kReach:
+          return 3;
+        case Gate::kIk:
+          return 4;
+        case Gate::kCollision:
+          return 5;
+        case Gate::kClearance:
+          return 6;
+        case Gate::kApproach:
+          return 7;
       }
       return 0;
     };
@@ -787,7 +835,8 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
         // and stay where they are: either must be clear of everything that stays.
         std::vector<std::pair<int, int>> holds_after;
         for (const auto& h : holds_at_keyframe) {
-          if (std::find(freed.begin(), freed.end(), h.first) == freed.end()) holds_after.push_back(h);
+          if (std::find(freed.begin(), freed.end(), h.first) == freed.end())
+            holds_after.push_back(h);
         }
         auto at_keyframe = [&](int r) -> JointVector {
           for (size_t i = 0; i < movers.size(); ++i) {
@@ -874,7 +923,8 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
     }
     for (const Mover& m : movers) EnableRobot(m.robot, true);
     std::string who;
-    for (const Mover& m : movers) who += (who.empty() ? "'" : ", '") + world_.robots[m.robot].name + "'";
+    for (const Mover& m : movers)
+      who += (who.empty() ? "'" : ", '") + world_.robots[m.robot].name + "'";
     note(search_gate == Gate::kNone ? Gate::kCollision : search_gate,
          leaf_message.empty() ? "every IK solution of " + who + " collides" : leaf_message);
   }

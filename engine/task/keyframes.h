@@ -53,12 +53,12 @@ struct TaskCounters {
 /// What validating an edge gave.
 struct EdgeOutcome {
   bool ok = false;
-  bool permanent = false;    ///< Failed for a reason more effort cannot change.
-  Gate gate = Gate::kNone;   ///< The gate that failed (most informative candidate).
-  std::string message;       ///< Why, in words.
-  Keyframe keyframe;         ///< The keyframe (ok only).
+  bool permanent = false;   ///< Failed for a reason more effort cannot change.
+  Gate gate = Gate::kNone;  ///< The gate that failed (most informative candidate).
+  std::string message;      ///< Why, in words.
+  Keyframe keyframe;        ///< The keyframe (ok only).
   std::optional<Keyframe> approach;
-  ContState next;            ///< Continuous state after the action (ok only).
+  ContState next;  ///< Continuous state after the action (ok only).
 };
 
 /// Validates edges and answers the cheap checks. Holds a copy of the cell: one per thread.
@@ -84,6 +84,10 @@ class KeyframeSolver {
   /// Cheap and context-free: the gripper of `robot` at `grasp` on an object at X_WA (fingers
   /// closed to the grasp) does not touch the parts of `other_node` at X_other.
   bool GripperClear(int robot, int grasp, const Iso3& X_WA, int other_node, const Iso3& X_other);
+  /// Robot-free and context-free: the end effectors of `robot_a` at grasp `grasp_a` and of
+  /// `robot_b` at grasp `grasp_b` of one object keep the robots' minimum clearance (the two
+  /// hands of a handover or of a two-handed hold).
+  bool GrippersApart(int robot_a, int grasp_a, int robot_b, int grasp_b);
   /// Cheap and context-free: `node` resting at X_WA leaves every robot room to stand at home
   /// (no link, end effector or finger of a robot at its home configuration touches it).
   bool ClearOfHomes(int node, const Iso3& X_WA);
@@ -96,8 +100,8 @@ class KeyframeSolver {
   /// Whether some orientation of the candidate set lets the assembly LP of `step` hold with the
   /// base in the air (cached by `key`).
   bool AirAssemblyPossible(int step, const std::vector<std::pair<int, int>>& moved_holders,
-                           const std::vector<std::pair<int, int>>& base_holders,
-                           std::uint64_t key, std::string* reason);
+                           const std::vector<std::pair<int, int>>& base_holders, std::uint64_t key,
+                           std::string* reason);
 
   /// TCP target of a robot holding node (at X_WA) with grasp id.
   Iso3 GraspTarget(const Iso3& X_WA, int grasp_id) const;
@@ -114,8 +118,8 @@ class KeyframeSolver {
   struct Attempt;
   bool SolveIk(int robot, const Iso3& X_WT, const JointVector& reference, int effort,
                std::mt19937_64& rng, std::vector<JointVector>& out);
-  void SetScene(const std::vector<PlanObject>& objects, const std::vector<std::pair<int, int>>& holds,
-                int allow_a, int allow_b);
+  void SetScene(const std::vector<PlanObject>& objects,
+                const std::vector<std::pair<int, int>>& holds, int allow_a, int allow_b);
   void SetRobot(int robot, const JointVector& q);
   void EnableRobot(int robot, bool on);
   bool Collides();
@@ -133,8 +137,8 @@ class KeyframeSolver {
   std::vector<int> part_object_;           // scratch: object index of each part in SetScene
   struct Fingers {
     BodyId body[2];
-    Iso3 X_FS0[2];       // finger box in the flange frame, closed
-    Vec3 per_metre[2];   // its translation per metre of opening
+    Iso3 X_FS0[2];      // finger box in the flange frame, closed
+    Vec3 per_metre[2];  // its translation per metre of opening
     double stroke = 0.0;
   };
   std::vector<std::optional<Fingers>> fingers_;  // per robot (two-finger grippers)

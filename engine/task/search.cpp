@@ -171,6 +171,18 @@ bool TaskSearch::GraspsApart(int grasp_a, int grasp_b) const {
   return X_AGa.linear().col(2).dot(X_AGb.linear().col(2)) < limit;
 }
 
+bool TaskSearch::HandsApart(int robot_a, int grasp_a, int robot_b, int grasp_b) {
+  if (!GraspsApart(grasp_a, grasp_b)) return false;
+  // Robot-free: robots with the same end effector answer alike.
+  const std::uint64_t key =
+      HashMix(HashMix(HashMix(HashMix(104, world_.robots[robot_a].grasp_set), grasp_a),
+                      world_.robots[robot_b].grasp_set),
+              grasp_b);
+  auto [it, inserted] = hands_apart_.try_emplace(key, true);
+  if (inserted) it->second = solver_.GrippersApart(robot_a, grasp_a, robot_b, grasp_b);
+  return it->second;
+}
+
 int TaskSearch::Heuristic(const SymState& s, const Milestone& m) {
   int h = 0;
   if (m.flat && !window_.empty()) {
@@ -497,7 +509,7 @@ void TaskSearch::Successors(const SymState& s, const Milestone& m, const Resolut
           for (int i = 0; i < n_grasps; ++i) {
             bool apart = true;
             for (int q = 0; q < n_robots_; ++q) {
-              if (s.held[q] == o && !GraspsApart(s.grasp[q], ids[i])) apart = false;
+              if (s.held[q] == o && !HandsApart(q, s.grasp[q], r, ids[i])) apart = false;
             }
             if (!apart) continue;
             if (loc >= 0 && !CheapPick(r, o, loc, ids[i])) continue;
@@ -516,7 +528,7 @@ void TaskSearch::Successors(const SymState& s, const Milestone& m, const Resolut
             if (s.held[q] == o) giver = q;
           }
           for (int i = 0; i < n_grasps; ++i) {
-            if (!GraspsApart(s.grasp[giver], ids[i])) continue;
+            if (!HandsApart(giver, s.grasp[giver], r, ids[i])) continue;
             TaskAction a;
             a.type = ActionType::kHandover;
             a.r1 = static_cast<int8_t>(giver);

@@ -168,6 +168,9 @@ class TaskSearch {
   /// `node` resting at location `loc` leaves every robot room at home (cached).
   bool HomesClear(int node, int loc);
   bool GraspsApart(int grasp_a, int grasp_b) const;
+  /// GraspsApart, and the two end effectors at those grasps keep the robots' clearance
+  /// (KeyframeSolver::GrippersApart; cached per pair of end effectors and grasps).
+  bool HandsApart(int robot_a, int grasp_a, int robot_b, int grasp_b);
   /// Abstract check before a milestone: some grasps of the moved input (one or two) and some
   /// support of the base (held by one gripper in some orientation, or resting in some
   /// placement, alone or braced) balance the step's mating wrench. Cached per step.
@@ -226,6 +229,7 @@ class TaskSearch {
   std::unordered_map<std::uint64_t, CheapAnswer> cheap_;      // cheap-check answers
   std::unordered_set<std::uint64_t> tallied_;            // cheap failures tallied in this milestone
   std::unordered_map<std::uint64_t, bool> homes_clear_;  // HomesClear per (node, location)
+  std::unordered_map<std::uint64_t, bool> hands_apart_;  // HandsApart answers
   std::map<int, std::pair<bool, std::string>> possible_;  // AssemblyPossible per step
   std::vector<Iso3> placement_pose_;                      // scratch
   long long expansions_ = 0;
