@@ -21,21 +21,10 @@ namespace {
 // An object set down where a robot's home pose reaches (here: right at ur5e_a's base) would leave
 // that robot nowhere to go: ClearOfHomes says so; the seat where it starts leaves every home free.
 TEST(KeyframeSolver, ObjectsInTheWayOfAHomeAreFlagged) {
-  const fs::path file = ProjectFile("stool");
-  const LoadedProject lp = LoadProject(file);
-  ASSERT_TRUE(lp.ok());
-  auto pre = PreprocessProject(lp, file);
-  ASSERT_TRUE(pre.has_value()) << pre.error().message;
-  auto world = BuildTaskWorld(*lp.project, lp.check, *pre, file);
-  ASSERT_TRUE(world.has_value()) << world.error().message;
-  CellOptions cell_options;
-  cell_options.objects_touch_table = false;
-  auto cell = Cell::Build(world->cell_def, cell_options);
-  ASSERT_TRUE(cell.has_value()) << cell.error().message;
-  TaskTables tables;
-  TaskCounters counters;
-  TaskPlannerOptions options;
-  KeyframeSolver solver(*world, tables, options, std::move(*cell), counters);
+  SolverRig rig;
+  ASSERT_EQ(rig.Build("stool"), "");
+  const std::optional<TaskWorld>& world = rig.world;
+  KeyframeSolver& solver = *rig.solver;
   const int seat = 0;
   ASSERT_EQ(world->tree->nodes[seat].name, "seat");
   EXPECT_TRUE(solver.ClearOfHomes(seat, world->initial_X_WA[seat]));
@@ -47,21 +36,10 @@ TEST(KeyframeSolver, ObjectsInTheWayOfAHomeAreFlagged) {
 // Two hands on one object: the same grasp twice puts the grippers into each other; on the seat
 // (30 cm across) some pair of its grasps leaves the two grippers the robots' clearance apart.
 TEST(KeyframeSolver, GrippersOfTwoHandsKeepTheirClearance) {
-  const fs::path file = ProjectFile("stool");
-  const LoadedProject lp = LoadProject(file);
-  ASSERT_TRUE(lp.ok());
-  auto pre = PreprocessProject(lp, file);
-  ASSERT_TRUE(pre.has_value()) << pre.error().message;
-  auto world = BuildTaskWorld(*lp.project, lp.check, *pre, file);
-  ASSERT_TRUE(world.has_value()) << world.error().message;
-  CellOptions cell_options;
-  cell_options.objects_touch_table = false;
-  auto cell = Cell::Build(world->cell_def, cell_options);
-  ASSERT_TRUE(cell.has_value()) << cell.error().message;
-  TaskTables tables;
-  TaskCounters counters;
-  TaskPlannerOptions options;
-  KeyframeSolver solver(*world, tables, options, std::move(*cell), counters);
+  SolverRig rig;
+  ASSERT_EQ(rig.Build("stool"), "");
+  const std::optional<TaskWorld>& world = rig.world;
+  KeyframeSolver& solver = *rig.solver;
   const int seat = 0, a = 0, b = 1;  // ur5e_a and ur5e_b: two-finger grippers
   const GraspSet* set = world->grasp_set(seat, a);
   ASSERT_NE(set, nullptr);
@@ -69,9 +47,9 @@ TEST(KeyframeSolver, GrippersOfTwoHandsKeepTheirClearance) {
   std::vector<int> ids;
   for (size_t i = 0; i < set->grasps.size(); ++i) {
     const Grasp& g = set->grasps[i];
-    ids.push_back(tables.Grasp(seat, static_cast<int>(i),
-                               GraspRef{seat, static_cast<int>(i), g.part, g.X_PG, g.width_m,
-                                        g.quality}));
+    ids.push_back(rig.tables.Grasp(
+        seat, static_cast<int>(i),
+        GraspRef{seat, static_cast<int>(i), g.part, g.X_PG, g.width_m, g.quality}));
   }
   EXPECT_FALSE(solver.GrippersApart(a, ids[0], b, ids[0]));
   bool some_apart = false;

@@ -9,8 +9,11 @@
 
 #include "grasp/preprocess.h"
 #include "model/validate.h"
+#include "robot/cell.h"
+#include "task/keyframes.h"
 #include "task/plan_validator.h"
 #include "task/planner.h"
+#include "task/world.h"
 
 namespace wrap {
 
@@ -65,5 +68,37 @@ inline std::string Issues(const PlanValidation& v) {
   for (const PlanIssue& i : v.issues) out += FormatIssue(i) + "\n";
   return out;
 }
+
+// The planner's pieces for one example project as PlanTask sets them up: the task world, the
+// tables and the keyframe solver (which keeps references to the rig's members: do not move it).
+struct SolverRig {
+  LoadedProject lp;
+  std::optional<Preprocessed> pre;
+  std::optional<TaskWorld> world;
+  TaskTables tables;
+  TaskCounters counters;
+  TaskPlannerOptions options;
+  std::optional<KeyframeSolver> solver;
+
+  // Empty when built, else what failed.
+  std::string Build(const std::string& project) {
+    const fs::path file = ProjectFile(project);
+    lp = LoadProject(file);
+    if (!lp.ok()) return project + ": does not load";
+    auto p = PreprocessProject(lp, file);
+    if (!p) return p.error().message;
+    pre = std::move(*p);
+    auto w = BuildTaskWorld(*lp.project, lp.check, *pre, file);
+    if (!w) return w.error().message;
+    world = std::move(*w);
+    CellOptions cell_options;
+    cell_options.objects_touch_table = false;
+    auto cell = Cell::Build(world->cell_def, cell_options);
+    if (!cell) return cell.error().message;
+    options.project_file = file;
+    solver.emplace(*world, tables, options, std::move(*cell), counters);
+    return {};
+  }
+};
 
 }  // namespace wrap

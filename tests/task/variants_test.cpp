@@ -136,38 +136,17 @@ TEST(FlatLazy, StopsAtTheMemoryLimitAndSaysSo) {
   }
 }
 
-// The planner's pieces for one project, as PlanTask sets them up, with one search per variant
-// over the same tables (so that their states mean the same).
-struct SearchRig {
-  LoadedProject lp;
-  std::optional<Preprocessed> pre;
-  std::optional<TaskWorld> world;
-  TaskTables tables;
-  TaskCounters counters;
-  TaskPlannerOptions options;
+// The rig (planning_fixture.h) with one search per variant over the same tables (so that their
+// states mean the same).
+struct SearchRig : SolverRig {
   std::vector<TaskPlannerOptions> variant_options;
-  std::optional<KeyframeSolver> solver;
   std::optional<RunContext> ctx;
   std::vector<std::unique_ptr<TaskSearch>> searches;
   SymState s0;
   ContState c0;
 
   bool Build(const std::string& project, const std::vector<std::string>& variants) {
-    const fs::path file = ProjectFile(project);
-    lp = LoadProject(file);
-    if (!lp.ok()) return false;
-    auto p = PreprocessProject(lp, file);
-    if (!p) return false;
-    pre = std::move(*p);
-    auto w = BuildTaskWorld(*lp.project, lp.check, *pre, file);
-    if (!w) return false;
-    world = std::move(*w);
-    CellOptions cell_options;
-    cell_options.objects_touch_table = false;
-    auto cell = Cell::Build(world->cell_def, cell_options);
-    if (!cell) return false;
-    options.project_file = file;
-    solver.emplace(*world, tables, options, std::move(*cell), counters);
+    if (!SolverRig::Build(project).empty()) return false;
     ctx.emplace(0);
     ctx->set_time_limit_s(120.0);
     variant_options.reserve(variants.size());  // searches keep references into it
