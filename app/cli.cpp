@@ -107,7 +107,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   plan->add_flag("--validate", plan_args.validate,
                  "Replay the plan with the independent validator; exit 1 if it fails");
   plan->add_flag("--task-only", plan_args.task_only,
-                 "Stop after the task plan (motion planning is not part of this build yet)");
+                 "Stop after the task plan: no keyframe optimisation, motion planning or "
+                 "retiming");
 
   // CLI11 takes arguments in reverse order.
   std::vector<std::string> reversed(args.rbegin(), args.rend());

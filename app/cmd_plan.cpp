@@ -7,6 +7,7 @@
 #include "load.h"
 #include "task/plan_json.h"
 #include "task/plan_validator.h"
+#include "pipeline/pipeline.h"
 #include "task/planner.h"
 
 namespace wrap::cli {
@@ -86,7 +87,11 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
     return ExitCodeFor(pre.error().code);
   }
   for (const std::string& w : pre->warnings) err << args.project << ": warning: " << w << "\n";
-  auto plan = PlanTask(p, loaded.check, *pre, options, ctx);
+  PipelineOptions pipeline;
+  pipeline.task = options;
+  pipeline.task_only = args.task_only;
+  pipeline.seed = seed;
+  auto plan = PlanAssembly(p, loaded.check, *pre, pipeline, ctx);
   if (!plan) {
     err << args.project << ": " << plan.error().message << "\n";
     return ExitCodeFor(plan.error().code);
@@ -107,8 +112,16 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
     for (size_t i = 0; i < plan->actions.size(); ++i) {
       out << "  " << (i + 1) << ". " << DescribeAction(*plan, plan->actions[i]) << "\n";
     }
-    if (!args.task_only) {
-      out << "(motion planning is not part of this build yet: the plan holds keyframes)\n";
+    if (st.motion) {
+      out << "Motion: makespan " << Fmt("%.1f", st.makespan_s) << " s (one segment at a time "
+          << Fmt("%.1f", st.makespan_sequential_s) << " s), " << st.motion_segments
+          << " segments; t_kf " << Fmt("%.2f", st.t_kf_s) << " s, t_mp " << Fmt("%.2f", st.t_mp_s)
+          << " s, t_retime " << Fmt("%.2f", st.t_retime_s) << " s";
+      if (st.motion_suspensions > 0 || st.task_plans > 1) {
+        out << " (" << st.motion_suspensions << " suspensions, " << st.task_plans
+            << " task plans)";
+      }
+      out << "\n";
     }
   } else {
     err << "No plan found in " << Fmt("%.1f", st.t_init_s) << " s: " << st.failure << "\n";

@@ -12,6 +12,8 @@ PACKAGES=(
   libqhull-dev libtbb-dev
   # robots: collision (FCL + libccd), URDF import
   libfcl-dev libccd-dev liburdfdom-dev
+  # motion planning: OMPL (its library links against these Boost components)
+  libompl-dev libboost-serialization-dev libboost-filesystem-dev libboost-system-dev
   # wrench LP: Clp (the reference LP solver behind the dense simplex)
   coinor-libclp-dev
   # sim: MuJoCo (its CMake config also wants libgl-dev and libqhull-dev, listed elsewhere here)

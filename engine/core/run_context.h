@@ -35,6 +35,10 @@ class RunContext {
   /// Receives progress reports.
   void set_progress(ProgressFn fn) { progress_ = std::move(fn); }
 
+  /// The stop token (for a sub-run that must stop with this one).
+  const std::stop_token& stop_token() const { return stop_; }
+  /// The deadline (time_point::max() when there is none).
+  Clock::time_point deadline() const { return deadline_; }
   /// True when cancelled.
   bool cancelled() const { return stop_.stop_requested(); }
   /// True when the deadline has passed.

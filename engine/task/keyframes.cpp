@@ -358,6 +358,22 @@ bool KeyframeSolver::SolveIk(int robot, const Iso3& X_WT, const JointVector& ref
   return !out.empty();
 }
 
+int KeyframeSolver::UrBranch(int robot, const JointVector& q) const {
+  const TaskRobot& r = world_.robots[robot];
+  const Iso3 X_BT = r.X_BW * TcpPose(r.chain, r.X_WB, q, r.end_effector.X_FT);
+  const UrIkSolutions sols = r.ur->SolveTcp(X_BT, r.end_effector.X_FT);
+  int best = -1;
+  double best_d = 1e9;
+  for (int k = 0; k < sols.count; ++k) {
+    const double d = (NearestEquivalent(r.chain, sols.q[k], q) - q).cwiseAbs().maxCoeff();
+    if (d < best_d) {
+      best_d = d;
+      best = sols.branch[k];
+    }
+  }
+  return best;
+}
+
 void KeyframeSolver::SetRobot(int robot, const JointVector& q) {
   ForwardKinematics(world_.robots[robot].chain, world_.robots[robot].X_WB, q, frames_[robot]);
   cell_.SetConfiguration(robot, std::span<const double>(q.data(), q.size()), frames_[robot]);
@@ -807,6 +823,21 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
         note(Gate::kIk, "no IK solution for '" + world_.robots[m.robot].name + "' at grasp " +
                             std::to_string(tables_.grasp(m.grasp).index));
         all = false;
+        continue;
+      }
+      // Two or more robots carrying one object move it as a rigid chain: a UR arm can only
+      // follow on its current IK branch (another one is behind a singularity).
+      if (s.held[m.robot] == m.node && world_.robots[m.robot].ur &&
+          std::count_if(movers.begin(), movers.end(), [&](const Mover& x) {
+            return x.node == m.node && s.held[x.robot] == x.node;
+          }) >= 2) {
+        const int branch = UrBranch(m.robot, c.q[m.robot]);
+        std::erase_if(sols[i], [&](const JointVector& q) { return UrBranch(m.robot, q) != branch; });
+        if (sols[i].empty()) {
+          note(Gate::kIk, "'" + world_.robots[m.robot].name +
+                              "' cannot carry its object there with the others on its IK branch");
+          all = false;
+        }
       }
     }
     if (!all) continue;

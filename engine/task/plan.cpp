@@ -1,6 +1,8 @@
 #include "task/plan.h"
 
+#include <algorithm>
 #include <array>
+#include <cassert>
 #include <utility>
 
 namespace wrap {
@@ -107,6 +109,47 @@ std::string DescribeAction(const Plan& plan, const PlanAction& action) {
     }
   }
   return "unknown action";
+}
+
+
+namespace {
+// Index of the last knot at or before t (0 when t is before the first).
+size_t KnotBefore(const RobotTrajectory& trajectory, double t) {
+  const auto& k = trajectory.knots;
+  auto it = std::upper_bound(k.begin(), k.end(), t,
+                             [](double v, const TrajectoryKnot& knot) { return v < knot.t; });
+  return it == k.begin() ? 0 : static_cast<size_t>(it - k.begin()) - 1;
+}
+}  // namespace
+
+JointVector SampleTrajectory(const RobotTrajectory& trajectory, double t, JointVector* qd) {
+  const auto& k = trajectory.knots;
+  assert(!k.empty());
+  if (t <= k.front().t || k.size() == 1) {
+    if (qd) *qd = JointVector::Zero(k.front().q.size());
+    return k.front().q;
+  }
+  if (t >= k.back().t) {
+    if (qd) *qd = JointVector::Zero(k.back().q.size());
+    return k.back().q;
+  }
+  const size_t i = KnotBefore(trajectory, t);
+  const TrajectoryKnot& a = k[i];
+  const TrajectoryKnot& b = k[i + 1];
+  const double span = b.t - a.t;
+  const double tau = t - a.t;
+  if (span <= 0.0) {
+    if (qd) *qd = b.qd;
+    return b.q;
+  }
+  const JointVector acc = (b.qd - a.qd) / span;
+  if (qd) *qd = a.qd + acc * tau;
+  return a.q + a.qd * tau + 0.5 * acc * tau * tau;
+}
+
+double OpeningAt(const RobotTrajectory& trajectory, double t) {
+  if (trajectory.knots.empty()) return -1.0;
+  return trajectory.knots[KnotBefore(trajectory, t)].opening_m;
 }
 
 }  // namespace wrap

@@ -105,9 +105,47 @@ struct PlanAction {
   /// Assemble: the moment before insertion, M `approach_m` back along the insertion axis; the
   /// insertion is a straight move from here to `keyframe`.
   std::optional<Keyframe> approach;
-  int milestone = -1;     ///< Index of the milestone (step in planning order) it belongs to.
-  double start_s = -1.0;  ///< Start time once retimed [s]; -1 before motion planning.
-  double end_s = -1.0;    ///< End time once retimed [s]; -1 before motion planning.
+  int milestone = -1;  ///< Index of the milestone (step in planning order) it belongs to.
+  /// Once retimed: when the first motion toward this action starts [s]; -1 without motion.
+  double start_s = -1.0;
+  /// Once retimed: the moment of the keyframe (grasp closed, gripper about to open, mated), when
+  /// every robot of `robots` is at its keyframe joints [s]; -1 without motion.
+  double end_s = -1.0;
+};
+
+/// A knot of a timed robot trajectory. Between two knots every joint moves with constant
+/// acceleration, so q, qd at both ends define the stretch: q(t) = q0 + qd0 tau + a tau^2 / 2
+/// with a = (qd1 - qd0) / (t1 - t0).
+struct TrajectoryKnot {
+  double t = 0.0;  ///< Time since the plan starts [s].
+  JointVector q;   ///< Joint positions [rad or m].
+  JointVector qd;  ///< Joint velocities [rad/s or m/s].
+  /// Finger opening from this knot to the next [m] (two-finger grippers: the width the fingers are
+  /// open to); -1: fully open (and for vacuum grippers).
+  double opening_m = -1.0;
+};
+
+/// One robot's timed trajectory, from time 0 to the makespan.
+struct RobotTrajectory {
+  int robot = -1;                     ///< Index into Project::robots.
+  std::vector<TrajectoryKnot> knots;  ///< Increasing times; the first at t = 0.
+};
+
+/// A stretch of motion as the motion planner made it: free-space paths planned in the composite
+/// space of the robots that move, and skills (straight moves along an approach, lift or insertion
+/// axis) with their own durations.
+struct MotionSegment {
+  /// "free" (planned path), "approach" (to a grasp along the gripper axis), "retreat" (away from
+  /// a released grasp), "lift" (a picked object up off the table), "descend" (onto the table at a
+  /// place), "insert" (along the insertion axis to the mating pose), "carry" (an object held by
+  /// several robots moved along a straight line), "grip" (gripper closes or opens at the keyframe).
+  std::string kind;
+  int action = -1;          ///< Action it leads to (or, after the last, the last action).
+  std::vector<int> robots;  ///< Robots that take part.
+  /// Objects (node ids) it moves or touches: carried, approached, released, inserted.
+  std::vector<int> objects;
+  double start_s = 0.0;     ///< Start [s].
+  double end_s = 0.0;       ///< End [s].
 };
 
 /// Statistics of a planner run (the paper's breakdown table and search counters).
@@ -142,6 +180,16 @@ struct PlanStats {
   /// and at every improvement.
   std::vector<std::pair<double, int>> cost_history;
   std::string failure;          ///< Empty when solved, else why not, in words.
+  // Motion (paper §IV-D keyframe optimisation, §IV-E motion planning, §IV-F retiming).
+  bool motion = false;               ///< Trajectories were planned (false: task plan only).
+  double t_kf_s = 0.0;               ///< Joint keyframe optimisation [s].
+  double t_mp_s = 0.0;               ///< Motion planning of the plan that succeeded [s].
+  double t_retime_s = 0.0;           ///< Retiming and scheduling [s].
+  double makespan_s = 0.0;           ///< Execution time with robots moving concurrently [s].
+  double makespan_sequential_s = 0.0;  ///< Same plan, one motion segment at a time [s].
+  int motion_segments = 0;           ///< Segments (free paths and skills).
+  int motion_suspensions = 0;        ///< Segments that timed out and were suspended.
+  int task_plans = 0;                ///< Task plans tried by the motion loop.
 };
 
 /// A plan of a project.
@@ -154,7 +202,16 @@ struct Plan {
   Keyframe initial;                     ///< Robots at home, parts at their initial poses.
   std::vector<PlanAction> actions;      ///< The action sequence.
   PlanStats stats;                      ///< How it was found.
+  /// Timed trajectories, one per robot (Project::robots order); empty without motion.
+  std::vector<RobotTrajectory> trajectories;
+  std::vector<MotionSegment> segments;  ///< How the motion was made, by start time.
 };
+
+/// Joint positions (and velocities when `qd` is given) of a trajectory at time t, clamped to its
+/// first and last knot. The trajectory must have knots.
+JointVector SampleTrajectory(const RobotTrajectory& trajectory, double t, JointVector* qd = nullptr);
+/// Finger opening of a trajectory at time t (the opening of the last knot at or before t).
+double OpeningAt(const RobotTrajectory& trajectory, double t);
 
 /// The action in words, e.g. "r2 hands 'leg1' over to r3 (grasp 7 -> grasp 12)", with the
 /// plan's names.

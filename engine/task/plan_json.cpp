@@ -88,7 +88,46 @@ ojson StatsJson(const PlanStats& s) {
                {"first_cost", s.first_cost},
                {"t_opt_s", s.t_opt_s},
                {"cost_history", CostHistoryJson(s.cost_history)},
+               {"motion", s.motion},
+               {"t_kf_s", s.t_kf_s},
+               {"t_mp_s", s.t_mp_s},
+               {"t_retime_s", s.t_retime_s},
+               {"makespan_s", s.makespan_s},
+               {"makespan_sequential_s", s.makespan_sequential_s},
+               {"motion_segments", s.motion_segments},
+               {"motion_suspensions", s.motion_suspensions},
+               {"task_plans", s.task_plans},
                {"failure", s.failure}};
+}
+
+ojson NumbersJson(const JointVector& v) {
+  ojson out = ojson::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) out.push_back(v[i]);
+  return out;
+}
+
+// One robot's trajectory as columns: t, q, qd, opening_m (one entry per knot each).
+ojson TrajectoryJson(const Plan& plan, const RobotTrajectory& tr) {
+  ojson t = ojson::array(), q = ojson::array(), qd = ojson::array(), opening = ojson::array();
+  for (const TrajectoryKnot& k : tr.knots) {
+    t.push_back(k.t);
+    q.push_back(NumbersJson(k.q));
+    qd.push_back(NumbersJson(k.qd));
+    opening.push_back(k.opening_m);
+  }
+  return ojson{{"robot", NameOr(plan.robots, tr.robot)},
+               {"t", t},
+               {"q", q},
+               {"qd", qd},
+               {"opening_m", opening}};
+}
+
+ojson SegmentJson(const Plan& plan, const MotionSegment& m) {
+  ojson robots = ojson::array(), objects = ojson::array();
+  for (int r : m.robots) robots.push_back(NameOr(plan.robots, r));
+  for (int o : m.objects) objects.push_back(NameOr(plan.nodes, o));
+  return ojson{{"kind", m.kind},     {"action", m.action},   {"robots", robots},
+               {"objects", objects}, {"start_s", m.start_s}, {"end_s", m.end_s}};
 }
 
 ojson ActionJson(const Plan& plan, const PlanAction& a, size_t index) {
@@ -497,6 +536,69 @@ class PlanReader {
     return h;
   }
 
+  // The motion part of a plan.
+ public:
+  RobotTrajectory ReadTrajectory(const json& e, const std::string& at) {
+    ExpectObject(e, at);
+    CheckKeys(e, at, {"robot", "t", "q", "qd", "opening_m"});
+    RobotTrajectory tr;
+    tr.robot = RobotValue(Member(e, at, "robot"), Join(at, "robot"));
+    const size_t dof = tr.robot < static_cast<int>(dof_.size()) ? dof_[tr.robot] : 0;
+    const json& t = ExpectArray(Member(e, at, "t"), Join(at, "t"));
+    const json& q = ExpectArray(Member(e, at, "q"), Join(at, "q"));
+    const json& qd = ExpectArray(Member(e, at, "qd"), Join(at, "qd"));
+    const json& opening = ExpectArray(Member(e, at, "opening_m"), Join(at, "opening_m"));
+    if (t.empty()) Bad(Join(at, "t"), "expected at least one knot");
+    for (const char* key : {"q", "qd", "opening_m"}) {
+      if (Member(e, at, key).size() != t.size()) {
+        Bad(Join(at, key), "expected " + std::to_string(t.size()) + " entries (one per time in " +
+                               "\"t\"), found " + std::to_string(Member(e, at, key).size()));
+      }
+    }
+    auto vector = [&](const json& values, const std::string& path) {
+      if (!values.is_array() || values.size() != dof) {
+        Bad(path, "expected an array of " + std::to_string(dof) + " numbers (the robot's joints)");
+      }
+      JointVector v(static_cast<Eigen::Index>(dof));
+      for (size_t k = 0; k < dof; ++k) v[static_cast<Eigen::Index>(k)] = NumberValue(values[k], Index(path, k));
+      return v;
+    };
+    for (size_t k = 0; k < t.size(); ++k) {
+      TrajectoryKnot knot;
+      knot.t = NumberValue(t[k], Index(Join(at, "t"), k));
+      if (k == 0 && knot.t != 0.0) Bad(Index(Join(at, "t"), k), "the first knot must be at 0 s");
+      if (k > 0 && !(knot.t >= tr.knots.back().t)) {
+        Bad(Index(Join(at, "t"), k), "times must not decrease (previous " +
+                                         std::to_string(tr.knots.back().t) + ")");
+      }
+      knot.q = vector(q[k], Index(Join(at, "q"), k));
+      knot.qd = vector(qd[k], Index(Join(at, "qd"), k));
+      knot.opening_m = NumberValue(opening[k], Index(Join(at, "opening_m"), k));
+      tr.knots.push_back(std::move(knot));
+    }
+    return tr;
+  }
+  MotionSegment ReadSegment(const json& e, const std::string& at) {
+    ExpectObject(e, at);
+    CheckKeys(e, at, {"kind", "action", "robots", "objects", "start_s", "end_s"});
+    MotionSegment m;
+    m.kind = String(e, at, "kind");
+    m.action = Int(e, at, "action", -1, static_cast<int>(plan_.actions.size()) - 1);
+    const json& robots = ExpectArray(Member(e, at, "robots"), Join(at, "robots"));
+    for (size_t k = 0; k < robots.size(); ++k) {
+      m.robots.push_back(RobotValue(robots[k], Index(Join(at, "robots"), k)));
+    }
+    const json& objects = ExpectArray(Member(e, at, "objects"), Join(at, "objects"));
+    for (size_t k = 0; k < objects.size(); ++k) {
+      m.objects.push_back(NodeValue(objects[k], Index(Join(at, "objects"), k)));
+    }
+    m.start_s = NonNegative(e, at, "start_s");
+    m.end_s = NonNegative(e, at, "end_s");
+    if (m.end_s < m.start_s) Bad(Join(at, "end_s"), "ends before it starts");
+    return m;
+  }
+
+ private:
   Plan& plan_;
   std::map<std::string, int> robots_, parts_, nodes_;
   std::vector<size_t> dof_;  // Joint-vector size per robot, from the first keyframe read.
@@ -510,7 +612,10 @@ PlanStats ReadStats(const json& root, const std::string& at) {
                     "grasps",     "expansions",    "validations", "validation_failures",
                     "lp_checks",  "lp_cache_hits", "ik_calls",    "collision_checks",
                     "milestones", "backtracks",    "widenings",   "out_of_memory",
-                    "first_cost", "t_opt_s",       "cost_history", "failure"});
+                    "first_cost", "t_opt_s",       "cost_history", "failure",
+                    "motion",     "t_kf_s",        "t_mp_s",      "t_retime_s",
+                    "makespan_s", "makespan_sequential_s",        "motion_segments",
+                    "motion_suspensions",          "task_plans"});
   PlanStats s;
   // Required: what DESIGN.md promises every plan file holds.
   s.solved = Bool(j, at, "solved");
@@ -568,6 +673,15 @@ PlanStats ReadStats(const json& root, const std::string& at) {
     }
   }
   if (Find(j, "failure")) s.failure = String(j, at, "failure");
+  if (Find(j, "motion")) s.motion = Bool(j, at, "motion");
+  time("t_kf_s", s.t_kf_s);
+  time("t_mp_s", s.t_mp_s);
+  time("t_retime_s", s.t_retime_s);
+  time("makespan_s", s.makespan_s);
+  time("makespan_sequential_s", s.makespan_sequential_s);
+  small("motion_segments", s.motion_segments);
+  small("motion_suspensions", s.motion_suspensions);
+  small("task_plans", s.task_plans);
   return s;
 }
 
@@ -576,7 +690,7 @@ Plan ReadPlan(const json& root) {
     Bad("", "expected a JSON object at the top level, found " + TypeName(root));
   CheckKeys(root, "",
             {"format", "version", "project", "robots", "parts", "nodes", "milestones", "stats",
-             "initial", "actions"});
+             "initial", "actions", "trajectories", "segments"});
   const std::string format = String(root, "", "format");
   if (format != kFormatName) {
     Bad("format", "expected \"" + std::string(kFormatName) + "\", found \"" + format + "\"");
@@ -624,6 +738,31 @@ Plan ReadPlan(const json& root) {
   const json& actions = ExpectArray(Member(root, "", "actions"), "actions");
   for (size_t i = 0; i < actions.size(); ++i) {
     plan.actions.push_back(reader.ReadAction(actions[i], Index("actions", i), i));
+  }
+  if (const json* trajectories = Find(root, "trajectories")) {
+    ExpectArray(*trajectories, "trajectories");
+    std::set<int> seen;
+    for (size_t i = 0; i < trajectories->size(); ++i) {
+      RobotTrajectory tr = reader.ReadTrajectory((*trajectories)[i], Index("trajectories", i));
+      if (!seen.insert(tr.robot).second) {
+        Bad(Join(Index("trajectories", i), "robot"),
+            "robot '" + plan.robots[tr.robot] + "' has two trajectories");
+      }
+      plan.trajectories.push_back(std::move(tr));
+    }
+    if (!plan.trajectories.empty() && plan.trajectories.size() != plan.robots.size()) {
+      Bad("trajectories", "expected one trajectory per robot (" +
+                              std::to_string(plan.robots.size()) + "), found " +
+                              std::to_string(plan.trajectories.size()));
+    }
+    std::sort(plan.trajectories.begin(), plan.trajectories.end(),
+              [](const RobotTrajectory& a, const RobotTrajectory& b) { return a.robot < b.robot; });
+  }
+  if (const json* segments = Find(root, "segments")) {
+    ExpectArray(*segments, "segments");
+    for (size_t i = 0; i < segments->size(); ++i) {
+      plan.segments.push_back(reader.ReadSegment((*segments)[i], Index("segments", i)));
+    }
   }
   return plan;
 }
@@ -742,6 +881,14 @@ std::string SerializePlan(const Plan& plan) {
     actions.push_back(ActionJson(plan, plan.actions[i], i));
   }
   doc["actions"] = actions;
+  if (!plan.trajectories.empty()) {
+    ojson trajectories = ojson::array();
+    for (const RobotTrajectory& tr : plan.trajectories) trajectories.push_back(TrajectoryJson(plan, tr));
+    doc["trajectories"] = trajectories;
+    ojson segments = ojson::array();
+    for (const MotionSegment& m : plan.segments) segments.push_back(SegmentJson(plan, m));
+    doc["segments"] = segments;
+  }
   // Keys keep the order written here (ordered_json); invalid UTF-8 in names is replaced, never
   // thrown.
   return doc.dump(2, ' ', false, ojson::error_handler_t::replace) + "\n";

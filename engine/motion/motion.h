@@ -1,0 +1,33 @@
+// Motion of one task plan (paper §IV-E, §IV-F): the geometric motion (free paths and skills) at
+// an effort level, then retiming into per-robot trajectories that run concurrently where the
+// robots do not depend on each other. The front door of the motion stage.
+#pragma once
+
+#include <cstdint>
+
+#include "core/result.h"
+#include "core/run_context.h"
+#include "motion/segments.h"
+#include "task/plan.h"
+#include "task/world.h"
+
+namespace wrap {
+
+/// What one motion attempt gave.
+struct MotionAttempt {
+  bool solved = false;    ///< Trajectories were made (plan updated).
+  MotionFailure failure;  ///< Otherwise which segment failed and whether to retry with more effort.
+  double t_mp_s = 0.0;      ///< Geometric motion [s].
+  double t_retime_s = 0.0;  ///< Retiming [s].
+};
+
+/// Plans the motion of `plan` at effort level `effort` (the free paths' budget is
+/// options.segment_time_s * 2^effort; `cache` keeps the paths solved by earlier attempts on the
+/// same plan). On success fills plan.trajectories, plan.segments, every action's start_s and
+/// end_s, and the stats' makespan_s, makespan_sequential_s, motion_segments and motion = true.
+/// Fails with kCancelled when ctx is cancelled, kInvalidInput when the plan does not fit the world.
+Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const MotionOptions& options,
+                                 int effort, std::uint64_t seed, MotionCache& cache,
+                                 RunContext& ctx);
+
+}  // namespace wrap

@@ -1,0 +1,54 @@
+// The one adapter to OMPL (paper §IV-E): a collision-free path between two configurations of a
+// composite joint space, found by RRT-Connect and shortened by shortcutting. Nothing else in Wrap
+// includes OMPL headers.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace wrap {
+
+/// A path query in a box-bounded joint space.
+struct PathQuery {
+  Eigen::VectorXd lower;  ///< Lower bound per coordinate [rad or m].
+  Eigen::VectorXd upper;  ///< Upper bound per coordinate.
+  Eigen::VectorXd start;  ///< Start configuration (must be valid).
+  Eigen::VectorXd goal;   ///< Goal configuration (must be valid).
+  /// State validity (collision-free); called from the planner's thread only.
+  std::function<bool(const Eigen::VectorXd&)> valid;
+  /// Motions are checked at states no farther apart than this in any coordinate [rad or m].
+  double resolution = 0.02;
+  double time_limit_s = 1.0;  ///< RRT-Connect's budget [s].
+  std::uint64_t seed = 0;     ///< Seeds sampling and shortcutting (deterministic per seed).
+  /// Checked while planning: true stops at once (cancellation).
+  std::function<bool()> stop;
+  int shortcut_attempts = 60;  ///< Random shortcut attempts after the path is found.
+  /// RRT-Connect's extension length, per square root of the dimension [rad].
+  double range_per_sqrt_dim = 0.4;
+};
+
+/// What PlanPath found.
+struct PathAnswer {
+  bool solved = false;                ///< A path was found.
+  bool timed_out = false;             ///< Not solved within the budget (more effort may help).
+  std::vector<Eigen::VectorXd> path;  ///< Waypoints from start to goal (solved only).
+  long long checks = 0;               ///< State validity checks.
+  std::string why;                    ///< When not solved: why, in words.
+};
+
+/// True when the straight motion from a to b is valid at the query's resolution (both ends
+/// included); counts checks.
+bool StraightMotionValid(const PathQuery& query, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                         long long* checks = nullptr);
+
+/// A path from query.start to query.goal: the straight motion when it is valid, else RRT-Connect
+/// (OMPL) within the time limit, then shortcutting (random pairs of points along the path joined
+/// by straight motions) and removal of waypoints whose neighbours see each other. Deterministic for
+/// a given seed when it does not run out of time.
+PathAnswer PlanPath(const PathQuery& query);
+
+}  // namespace wrap

@@ -1,0 +1,973 @@
+#include "motion/segments.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <random>
+#include <set>
+#include <utility>
+
+#include "motion/ompl_adapter.h"
+#include "robot/ik.h"
+#include "robot/kinematics.h"
+
+namespace wrap {
+
+namespace {
+
+constexpr std::array<std::string_view, 8> kKindNames = {
+    "free", "approach", "retreat", "lift", "descend", "insert", "carry", "grip"};
+
+// Largest joint jump between two IK samples of a straight move before it counts as a branch
+// switch (no straight move there) [rad].
+constexpr double kMaxTrackJump = 0.25;
+// A tracked straight move must end this close to its keyframe's joints [rad]; farther, it has
+// reached another IK solution of the same TCP pose, which replaces the keyframe's when valid.
+constexpr double kMaxSnap = 0.05;
+// Least distance between two robots at a keyframe, as the task planner keeps it [m].
+constexpr double kMinClearance = 0.005;
+
+bool Same(const JointVector& a, const JointVector& b) {
+  return a.size() == b.size() && (a - b).cwiseAbs().maxCoeff() <= 1e-9;
+}
+
+bool SamePose(const Iso3& a, const Iso3& b) {
+  return (a.translation() - b.translation()).norm() <= 1e-7 &&
+         (a.linear() - b.linear()).cwiseAbs().maxCoeff() <= 1e-7;
+}
+
+std::uint64_t Mix(std::uint64_t a, std::uint64_t b) {
+  std::uint64_t x = a ^ (b + 0x9e3779b97f4a7c15ULL + (a << 6) + (a >> 2));
+  x ^= x >> 31;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  x ^= x >> 29;
+  return x;
+}
+
+const PlanObject* FindObject(const Keyframe& k, int node) {
+  for (const PlanObject& o : k.objects) {
+    if (o.node == node) return &o;
+  }
+  return nullptr;
+}
+
+class Builder {
+ public:
+  Builder(const TaskWorld& world, Plan& plan, const MotionOptions& options, int effort,
+          std::uint64_t seed, MotionCache& cache, RunContext& ctx, MotionFailure* failure)
+      : w_(world),
+        plan_(plan),
+        opt_(options),
+        effort_(effort),
+        seed_(seed),
+        cache_(cache),
+        ctx_(ctx),
+        failure_(failure) {}
+
+  Result<std::vector<GeoSegment>> Run();
+
+ private:
+  // Straight TCP moves of `robots` from `q0`: robot i's TCP follows targets[i](s), s in [0, 1],
+  // in `steps` samples. Empty on failure (no IK, a branch jump).
+  // With `goals`, a redundant arm is pulled toward its goal joints along the way.
+  std::vector<std::vector<JointVector>> Track(
+      const std::vector<int>& robots, const std::vector<JointVector>& q0,
+      const std::vector<std::function<Iso3(double)>>& targets, int steps,
+      const std::vector<JointVector>* goals = nullptr);
+  // Branch id of a UR arm's configuration (the closed form's solution nearest to it).
+  int UrBranch(int robot, const JointVector& q) const;
+  // Collision-free straight joint motion between consecutive waypoints (scene already set).
+  bool PathClear(const std::vector<int>& robots,
+                 const std::vector<std::vector<JointVector>>& waypoints);
+  Result<void> SetScene(const std::vector<double>& openings,
+                        const std::vector<std::pair<int, int>>& mating = {},
+                        const std::vector<int>& table_ok = {},
+                        const std::vector<std::pair<int, int>>& gripper_ok = {});
+  bool Fail(int action, SegmentKind kind, bool suspend, const std::string& message);
+  Iso3 Tcp(int robot, const JointVector& q) const {
+    const TaskRobot& r = w_.robots[robot];
+    return TcpPose(r.chain, r.X_WB, q, r.end_effector.X_FT);
+  }
+  std::string Name(int robot) const { return "'" + w_.robots[robot].name + "'"; }
+  std::string NodeName(int node) const {
+    return node >= 0 && node < static_cast<int>(plan_.nodes.size()) ? "'" + plan_.nodes[node] + "'"
+                                                                     : "object";
+  }
+  // Adds the segment with the robots' current openings, advancing cur_ to its last waypoint.
+  void Push(GeoSegment seg);
+  // Fills seg.boxes (scene at the segment's start).
+  void Sweep(GeoSegment& seg);
+  // Backs robot r's TCP away from q along its approach axis (TCP z) by up to approach_m,
+  // collision-free in the current scene; the waypoints from q outwards, or empty.
+  std::vector<JointVector> BackOff(int robot, const JointVector& q, double* length);
+  bool Retreat(int action, int robot);
+  bool Free(int action, bool main, const std::vector<int>& robots,
+            const std::vector<JointVector>& goals, const std::vector<int>& objects);
+  bool Lift(int action, int node, const std::vector<int>& holders);
+  bool Carry(int action, int node, const std::vector<int>& holders, const Iso3& X_goal,
+             std::vector<JointVector> goal_q, const Keyframe& target, bool approach);
+  bool Action(int index);
+  bool Return(int action, int robot, const JointVector& goal, bool main);
+  // Robot r at `q` instead of its joints at the keyframe `kf` (same TCP): collision-free and
+  // clear of the other robots there (objects at the keyframe's poses, `mating` allowed).
+  bool KeyframeAccepts(int robot, const JointVector& q, const Keyframe& kf,
+                       const std::vector<std::pair<int, int>>& mating);
+  // Moves robot r from `old_q` to `new_q` at action `action`'s approach keyframe (when
+  // `from_approach`) or keyframe and at every following keyframe where it kept `old_q`.
+  void Rebranch(int robot, int action, bool from_approach, const JointVector& old_q,
+                const JointVector& new_q);
+
+  const TaskWorld& w_;
+  Plan& plan_;
+  const MotionOptions& opt_;
+  int effort_;
+  std::uint64_t seed_;
+  MotionCache& cache_;
+  RunContext& ctx_;
+  MotionFailure* failure_;
+
+  MotionScene scene_;
+  std::vector<PlanState> states_;
+  PlanState state_;
+  std::vector<JointVector> cur_;
+  std::vector<double> opening_;
+  std::vector<int> released_;  // per robot: object let go at its last event, not yet backed off
+  std::set<int> grounded_;     // objects touching the table top
+  std::vector<GeoSegment> out_;
+  int free_index_ = 0;
+  bool cancelled_ = false;
+  std::string last_hit_;  // the bodies of the last collision PathClear met
+  std::mt19937_64 rng_;
+};
+
+Result<void> Builder::SetScene(const std::vector<double>& openings,
+                               const std::vector<std::pair<int, int>>& mating,
+                               const std::vector<int>& table_ok,
+                               const std::vector<std::pair<int, int>>& gripper_ok) {
+  // Objects still where they were picked from touch the table until they are lifted.
+  std::vector<int> on_table = table_ok;
+  on_table.insert(on_table.end(), grounded_.begin(), grounded_.end());
+  return scene_.Set(state_, openings, cur_, mating, on_table, gripper_ok);
+}
+
+bool Builder::Fail(int action, SegmentKind kind, bool suspend, const std::string& message) {
+  if (failure_) {
+    failure_->action = action;
+    failure_->segment = std::string(ToString(kind));
+    failure_->suspend = suspend;
+    failure_->message = message;
+  }
+  return false;
+}
+
+void Builder::Push(GeoSegment seg) {
+  if (seg.openings.empty()) seg.openings = opening_;
+  Sweep(seg);
+  for (size_t i = 0; i < seg.robots.size(); ++i) cur_[seg.robots[i]] = seg.waypoints.back()[i];
+  out_.push_back(std::move(seg));
+}
+
+void Builder::Sweep(GeoSegment& seg) {
+  // Samples no farther apart than kSweepStep in the sum of joint changes: with links at most
+  // kLever from their joints, a body point between two samples lies within kSweepMargin of one.
+  constexpr double kSweepStep = 0.03;   // [rad]
+  constexpr double kLever = 1.5;        // [m]
+  constexpr double kSweepMargin = 0.5 * kSweepStep * kLever + 0.01;
+  if (!SetScene(seg.openings)) return;
+  std::vector<Aabb> boxes;
+  std::vector<Aabb> sample;
+  auto add = [&](bool first) {
+    sample.clear();
+    for (int r : seg.robots) scene_.AppendBoxes(r, sample);
+    for (int node : seg.objects) {
+      if (state_.objects.count(node)) scene_.AppendObjectBoxes(node, sample);
+    }
+    if (first || boxes.size() != sample.size()) {
+      boxes.insert(boxes.end(), sample.begin(), sample.end());
+      return;
+    }
+    for (size_t b = 0; b < sample.size(); ++b) {
+      boxes[b].min = boxes[b].min.cwiseMin(sample[b].min);
+      boxes[b].max = boxes[b].max.cwiseMax(sample[b].max);
+    }
+  };
+  const auto& wp = seg.waypoints;
+  for (size_t i = 0; i < seg.robots.size(); ++i) scene_.SetRobot(seg.robots[i], wp[0][i]);
+  add(true);
+  for (size_t k = 1; k < wp.size(); ++k) {
+    double l1 = 0.0;
+    for (size_t i = 0; i < seg.robots.size(); ++i) l1 += (wp[k][i] - wp[k - 1][i]).cwiseAbs().sum();
+    const int steps = std::max(1, static_cast<int>(std::ceil(l1 / kSweepStep)));
+    for (int s = 1; s <= steps; ++s) {
+      const double t = static_cast<double>(s) / steps;
+      for (size_t i = 0; i < seg.robots.size(); ++i) {
+        scene_.SetRobot(seg.robots[i], wp[k - 1][i] + t * (wp[k][i] - wp[k - 1][i]));
+      }
+      add(false);
+    }
+  }
+  for (Aabb& b : boxes) {
+    b.min.array() -= kSweepMargin;
+    b.max.array() += kSweepMargin;
+  }
+  seg.boxes = std::move(boxes);
+}
+
+int Builder::UrBranch(int robot, const JointVector& q) const {
+  const TaskRobot& r = w_.robots[robot];
+  const UrIkSolutions sols = r.ur->SolveTcp(r.X_BW * Tcp(robot, q), r.end_effector.X_FT);
+  int best = -1;
+  double best_d = 1e9;
+  for (int k = 0; k < sols.count; ++k) {
+    const JointVector e = NearestEquivalent(r.chain, sols.q[k], q);
+    const double d = (e - q).cwiseAbs().maxCoeff();
+    if (d < best_d) {
+      best_d = d;
+      best = sols.branch[k];
+    }
+  }
+  return best;
+}
+
+std::vector<std::vector<JointVector>> Builder::Track(
+    const std::vector<int>& robots, const std::vector<JointVector>& q0,
+    const std::vector<std::function<Iso3(double)>>& targets, int steps,
+    const std::vector<JointVector>* goals) {
+  std::vector<std::vector<JointVector>> out(steps + 1, std::vector<JointVector>(robots.size()));
+  NumericIkOptions ik;
+  ik.restarts = 0;
+  ik.max_iterations = 60;
+  for (size_t i = 0; i < robots.size(); ++i) {
+    const TaskRobot& r = w_.robots[robots[i]];
+    JointVector q = q0[i];
+    out[0][i] = q;
+    // UR arms: the closed form on the start's branch (continuous away from singularities).
+    const int branch = r.ur ? UrBranch(robots[i], q) : -1;
+    for (int k = 1; k <= steps; ++k) {
+      const double s = static_cast<double>(k) / steps;
+      const Iso3 X_BT = r.X_BW * targets[i](s);
+      JointVector next;
+      if (branch >= 0) {
+        UrIkOptions options;
+        options.q6_if_singular = q[5];
+        const UrIkSolutions sols = r.ur->SolveTcp(X_BT, r.end_effector.X_FT, options);
+        for (int c = 0; c < sols.count; ++c) {
+          if (sols.branch[c] == branch) next = NearestEquivalent(r.chain, sols.q[c], q);
+        }
+        if (next.size() == 0) return {};
+      } else {
+        NumericIkRequest req;
+        req.X_BT = X_BT;
+        req.X_FT = r.end_effector.X_FT;
+        req.seeds = {q};
+        // A redundant arm drifts toward its goal joints where it has a choice.
+        req.reference = goals ? JointVector(q0[i] + s * ((*goals)[i] - q0[i])) : q;
+        auto sol = SolveNumericIk(r.chain, req, rng_, ik);
+        if (!sol) return {};
+        next = sol->q;
+      }
+      if ((next - q).cwiseAbs().maxCoeff() > kMaxTrackJump) return {};
+      q = next;
+      out[k][i] = q;
+    }
+  }
+  return out;
+}
+
+bool Builder::PathClear(const std::vector<int>& robots,
+                        const std::vector<std::vector<JointVector>>& waypoints) {
+  for (size_t k = 0; k < waypoints.size(); ++k) {
+    const size_t prev = k == 0 ? 0 : k - 1;
+    double span = 0.0;
+    for (size_t i = 0; i < robots.size(); ++i) {
+      span = std::max(span, (waypoints[k][i] - waypoints[prev][i]).cwiseAbs().maxCoeff());
+    }
+    const int steps = std::max(1, static_cast<int>(std::ceil(span / opt_.resolution_rad)));
+    for (int s = (k == 0 ? steps : 1); s <= steps; ++s) {
+      const double t = static_cast<double>(s) / steps;
+      for (size_t i = 0; i < robots.size(); ++i) {
+        scene_.SetRobot(robots[i], waypoints[prev][i] + t * (waypoints[k][i] - waypoints[prev][i]));
+      }
+      if (scene_.Collides(robots)) {
+        CollisionResult hit;
+        scene_.cell().InCollision(&hit);
+        const CollisionWorld& cw = scene_.cell().world();
+        last_hit_ = "'" + cw.body_name(hit.first.body_a) + "' hits '" +
+                    cw.body_name(hit.first.body_b) + "'";
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+std::vector<JointVector> Builder::BackOff(int robot, const JointVector& q, double* length) {
+  const Iso3 X0 = Tcp(robot, q);
+  const Vec3 axis = X0.linear().col(2);
+  for (double d : {opt_.approach_m, opt_.approach_m / 2, opt_.approach_m / 4}) {
+    const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
+    auto target = [X0, axis, d](double s) {
+      Iso3 X = X0;
+      X.translation() -= s * d * axis;
+      return X;
+    };
+    auto path = Track({robot}, {q}, {target}, steps);
+    if (path.empty()) {
+      last_hit_ = "no IK solution along the line";
+      continue;
+    }
+    if (!PathClear({robot}, path)) continue;
+    std::vector<JointVector> out;
+    for (auto& wp : path) out.push_back(wp[0]);
+    *length = d;
+    return out;
+  }
+  return {};
+}
+
+bool Builder::Retreat(int action, int robot) {
+  const int node = released_[robot];
+  if (node < 0) return true;
+  if (!SetScene(opening_, {}, {}, {{robot, node}})) return false;
+  double length = 0.0;
+  std::vector<JointVector> back = BackOff(robot, cur_[robot], &length);
+  if (back.empty()) {
+    return Fail(action, SegmentKind::kRetreat, false,
+                Name(robot) + " cannot back its gripper away from " + NodeName(node) +
+                    " along the gripper axis: " + last_hit_);
+  }
+  GeoSegment seg;
+  seg.kind = SegmentKind::kRetreat;
+  seg.action = action;
+  seg.robots = {robot};
+  seg.objects = {node};
+  for (JointVector& q : back) seg.waypoints.push_back({q});
+  seg.skill_length_m = length;
+  seg.skill_speed_mps = opt_.skill_speed_mps;
+  Push(std::move(seg));
+  released_[robot] = -1;
+  return true;
+}
+
+bool Builder::Free(int action, bool main, const std::vector<int>& robots,
+                   const std::vector<JointVector>& goals, const std::vector<int>& objects) {
+  std::vector<int> movers;
+  std::vector<JointVector> targets;
+  for (size_t i = 0; i < robots.size(); ++i) {
+    if (!Same(cur_[robots[i]], goals[i])) {
+      movers.push_back(robots[i]);
+      targets.push_back(goals[i]);
+    }
+  }
+  if (movers.empty()) return true;
+  const int index = free_index_++;
+  if (cache_.free_paths.size() <= static_cast<size_t>(index)) cache_.free_paths.resize(index + 1);
+  GeoSegment seg;
+  seg.kind = SegmentKind::kFree;
+  seg.action = action;
+  seg.main = main;
+  seg.robots = movers;
+  seg.objects = objects;
+  seg.openings = opening_;
+  if (!cache_.free_paths[index].empty()) {
+    seg.waypoints = cache_.free_paths[index];
+    Push(std::move(seg));
+    return true;
+  }
+  if (!SetScene(opening_)) return false;
+  PathQuery query;
+  int dim = 0;
+  for (int r : movers) dim += static_cast<int>(w_.robots[r].chain.joints.size());
+  query.lower.resize(dim);
+  query.upper.resize(dim);
+  query.start.resize(dim);
+  query.goal.resize(dim);
+  int k = 0;
+  for (size_t i = 0; i < movers.size(); ++i) {
+    const Chain& chain = w_.robots[movers[i]].chain;
+    for (size_t j = 0; j < chain.joints.size(); ++j, ++k) {
+      query.start[k] = cur_[movers[i]][j];
+      query.goal[k] = targets[i][j];
+      // Samples within half a turn beyond the ends (joints of +-2 pi would wrap in vain).
+      const double lo = std::min(query.start[k], query.goal[k]) - M_PI;
+      const double hi = std::max(query.start[k], query.goal[k]) + M_PI;
+      query.lower[k] = std::max(chain.joints[j].lower, lo);
+      query.upper[k] = std::min(chain.joints[j].upper, hi);
+    }
+  }
+  auto split = [&](const Eigen::VectorXd& x) {
+    std::vector<JointVector> qs(movers.size());
+    int o = 0;
+    for (size_t i = 0; i < movers.size(); ++i) {
+      const int n = static_cast<int>(w_.robots[movers[i]].chain.joints.size());
+      qs[i] = x.segment(o, n);
+      o += n;
+    }
+    return qs;
+  };
+  query.valid = [&](const Eigen::VectorXd& x) {
+    const std::vector<JointVector> qs = split(x);
+    for (size_t i = 0; i < movers.size(); ++i) scene_.SetRobot(movers[i], qs[i]);
+    return !scene_.Collides(movers);
+  };
+  query.resolution = opt_.resolution_rad;
+  query.time_limit_s = opt_.segment_time_s * std::pow(2.0, effort_);
+  query.seed = Mix(seed_, static_cast<std::uint64_t>(index));
+  query.stop = [this] { return ctx_.ShouldStop(); };
+  query.shortcut_attempts = opt_.shortcut_attempts;
+  const auto t_query = std::chrono::steady_clock::now();
+  const PathAnswer answer = PlanPath(query);
+  if (std::getenv("WRAP_MOTION_DEBUG") && !answer.solved) {
+    std::mt19937_64 g(1);
+    std::uniform_real_distribution<double> u(-0.1, 0.1);
+    int ok_s = 0, ok_g = 0;
+    for (int k = 0; k < 200; ++k) {
+      Eigen::VectorXd d(dim);
+      for (int j = 0; j < dim; ++j) d[j] = u(g);
+      ok_s += query.valid(query.start + d);
+      ok_g += query.valid(query.goal + d);
+    }
+    std::fprintf(stderr, "[free] local freedom: start %d/200, goal %d/200\n", ok_s, ok_g);
+    CollisionResult hit;
+    const std::vector<JointVector> qs = split(query.goal);
+    for (size_t i = 0; i < movers.size(); ++i) scene_.SetRobot(movers[i], qs[i]);
+  }
+  if (std::getenv("WRAP_MOTION_DEBUG")) {
+    std::fprintf(stderr, "[free] action %d robots %zu: %s, %lld checks, %.2f s, %zu waypoints\n",
+                 action + 1, movers.size(), answer.solved ? "solved" : answer.why.c_str(),
+                 answer.checks,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t_query).count(),
+                 answer.path.size());
+  }
+  if (!answer.solved) {
+    if (ctx_.cancelled()) cancelled_ = true;
+    std::string who;
+    for (int r : movers) who += (who.empty() ? "" : ", ") + Name(r);
+    return Fail(action, SegmentKind::kFree, answer.timed_out,
+                "no collision-free path for " + who + " toward action " +
+                    std::to_string(action + 1) + ": " + answer.why);
+  }
+  for (const Eigen::VectorXd& x : answer.path) seg.waypoints.push_back(split(x));
+  cache_.free_paths[index] = seg.waypoints;
+  Push(std::move(seg));
+  return true;
+}
+
+bool Builder::Lift(int action, int node, const std::vector<int>& holders) {
+  if (!SetScene(opening_, {}, {node})) return false;
+  std::vector<JointVector> q0;
+  std::vector<std::function<Iso3(double)>> targets;
+  const double d = opt_.lift_m;
+  for (int r : holders) {
+    q0.push_back(cur_[r]);
+    const Iso3 X0 = Tcp(r, cur_[r]);
+    targets.push_back([X0, d](double s) {
+      Iso3 X = X0;
+      X.translation().z() += s * d;
+      return X;
+    });
+  }
+  const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
+  auto path = Track(holders, q0, targets, steps);
+  if (path.empty()) last_hit_ = "no IK solution along the line";
+  if (path.empty() || !PathClear(holders, path)) {
+    return Fail(action, SegmentKind::kLift, false,
+                "the holders of " + NodeName(node) + " cannot lift it straight up off the table: " +
+                    last_hit_);
+  }
+  GeoSegment seg;
+  seg.kind = SegmentKind::kLift;
+  seg.action = action;
+  seg.main = true;
+  seg.robots = holders;
+  seg.objects = {node};
+  seg.waypoints = std::move(path);
+  seg.skill_length_m = d;
+  seg.skill_speed_mps = opt_.skill_speed_mps;
+  Push(std::move(seg));
+  grounded_.erase(node);
+  return true;
+}
+
+bool Builder::Carry(int action, int node, const std::vector<int>& holders, const Iso3& X_goal,
+                    std::vector<JointVector> goal_q, const Keyframe& target, bool approach) {
+  // The object's pose now, from its first holder's TCP.
+  const PlanGrasp& g0 = state_.grasp[holders[0]];
+  const Iso3 X_AT0 = w_.X_AP[g0.part] * g0.X_PG;
+  const Iso3 X_start = Tcp(holders[0], cur_[holders[0]]) * X_AT0.inverse();
+  const double dist = (X_goal.translation() - X_start.translation()).norm();
+  const Eigen::Quaterniond qa(X_start.linear());
+  const Eigen::Quaterniond qb(X_goal.linear());
+  const double angle = qa.angularDistance(qb);
+  const Vec3 pa = X_start.translation();
+  const Vec3 pb = X_goal.translation();
+  // Object paths tried in turn: straight; rotate, then translate; translate, then rotate; up
+  // 10 cm, across, down.
+  auto pose = [&](int variant, double s) {
+    double sr = s, st = s;
+    Vec3 lift = Vec3::Zero();
+    if (variant == 1) {
+      sr = std::min(1.0, 2 * s);
+      st = std::max(0.0, 2 * s - 1);
+    } else if (variant == 2) {
+      st = std::min(1.0, 2 * s);
+      sr = std::max(0.0, 2 * s - 1);
+    } else if (variant == 3) {
+      lift.z() = 0.10 * std::min(1.0, std::min(4 * s, 4 * (1 - s)));
+      st = std::clamp(2 * s - 0.5, 0.0, 1.0);
+    }
+    Iso3 X = Iso3::Identity();
+    X.linear() = qa.slerp(sr, qb).toRotationMatrix();
+    X.translation() = (1 - st) * pa + st * pb + lift;
+    return X;
+  };
+  const double length = dist + 0.2 + angle * 0.1;
+  const int steps = std::max(
+      2, static_cast<int>(std::ceil(std::max(length / opt_.cartesian_step_m, 2 * angle / 0.02))));
+  std::string why;
+  for (int variant = 0; variant < 4; ++variant) {
+    std::vector<JointVector> q0;
+    std::vector<std::function<Iso3(double)>> targets;
+    for (int r : holders) {
+      q0.push_back(cur_[r]);
+      const PlanGrasp& g = state_.grasp[r];
+      const Iso3 X_AT = w_.X_AP[g.part] * g.X_PG;
+      targets.push_back([&pose, variant, X_AT](double s) { return pose(variant, s) * X_AT; });
+    }
+    auto path = Track(holders, q0, targets, steps, &goal_q);
+    std::vector<JointVector> goals = goal_q;
+    std::vector<std::pair<size_t, JointVector>> rebranch;
+    why.clear();
+    if (path.empty()) {
+      why = "an arm cannot follow the object (no IK solution near the last one)";
+      continue;
+    }
+    for (size_t i = 0; i < holders.size() && why.empty(); ++i) {
+      const double off = (path.back()[i] - goals[i]).cwiseAbs().maxCoeff();
+      const JointVector same_pose =
+          NearestEquivalent(w_.robots[holders[i]].chain, goals[i], path.back()[i]);
+      if (off > kMaxSnap && (same_pose - path.back()[i]).cwiseAbs().maxCoeff() <= kMaxSnap) {
+        // The keyframe's joints up to turns of 2 pi: the same configuration.
+        rebranch.push_back({i, same_pose});
+        path.back()[i] = same_pose;
+      } else if (off > kMaxSnap) {
+        if (KeyframeAccepts(holders[i], path.back()[i], target, {})) {
+          rebranch.push_back({i, path.back()[i]});
+        } else {
+          why = Name(holders[i]) + " ends " + std::to_string(off).substr(0, 4) +
+                " rad away from its keyframe joints, on another IK solution that does not fit "
+                "the keyframe";
+        }
+      } else {
+        path.back()[i] = goals[i];
+      }
+    }
+    if (!why.empty()) continue;
+    if (!SetScene(opening_)) return false;
+    if (!PathClear(holders, path)) {
+      why = "on the way " + last_hit_;
+      continue;
+    }
+    for (const auto& [i, q] : rebranch) Rebranch(holders[i], action, approach, goal_q[i], q);
+    GeoSegment seg;
+    seg.kind = SegmentKind::kCarry;
+    seg.action = action;
+    seg.main = true;
+    seg.robots = holders;
+    seg.objects = {node};
+    seg.waypoints = std::move(path);
+    seg.skill_length_m = variant == 3 ? dist + 0.2 : std::max(dist, angle * 0.1);
+    seg.skill_speed_mps = opt_.carry_speed_mps;
+    Push(std::move(seg));
+    return true;
+  }
+  return Fail(action, SegmentKind::kCarry, false,
+              "the robots holding " + NodeName(node) +
+                  " cannot carry it together to its keyframe pose (straight, rotating first or "
+                  "last, or over the top): " +
+                  why);
+}
+
+bool Builder::KeyframeAccepts(int robot, const JointVector& q, const Keyframe& kf,
+                              const std::vector<std::pair<int, int>>& mating) {
+  PlanState at = state_;
+  for (const PlanObject& o : kf.objects) {
+    if (auto it = at.objects.find(o.node); it != at.objects.end()) it->second.X_WA = o.X_WA;
+  }
+  std::vector<JointVector> qs = kf.q;
+  qs[robot] = q;
+  if (!scene_.Set(at, opening_, qs, mating)) return false;
+  CollisionResult hit;
+  if (scene_.cell().InCollision(&hit)) {
+    if (std::getenv("WRAP_MOTION_DEBUG")) {
+      std::fprintf(stderr, "[keyframe] %s\n", scene_.cell().Describe(hit.first).c_str());
+    }
+    return false;
+  }
+  DistanceRequest request;
+  request.upper_bound_m = 0.02;
+  return scene_.cell().MinRobotClearance(request).distance >= kMinClearance;
+}
+
+void Builder::Rebranch(int robot, int action, bool from_approach, const JointVector& old_q,
+                       const JointVector& new_q) {
+  for (size_t j = static_cast<size_t>(action); j < plan_.actions.size(); ++j) {
+    PlanAction& b = plan_.actions[j];
+    if (b.approach && (from_approach || j > static_cast<size_t>(action))) {
+      if (!Same(b.approach->q[robot], old_q)) return;
+      b.approach->q[robot] = new_q;
+    }
+    if (!Same(b.keyframe.q[robot], old_q)) return;
+    b.keyframe.q[robot] = new_q;
+  }
+}
+
+bool Builder::Return(int action, int robot, const JointVector& goal, bool main) {
+  if (Same(cur_[robot], goal)) return true;
+  if (!Retreat(action, robot)) return false;
+  // Fingers open fully on the way, unless that hits something where the robot is.
+  const double saved = opening_[robot];
+  opening_[robot] = -1.0;
+  if (!SetScene(opening_)) return false;
+  if (scene_.Collides(std::vector<int>{robot})) opening_[robot] = saved;
+  return Free(action, main, {robot}, {goal}, {});
+}
+
+bool Builder::Action(int i) {
+  const PlanAction& a = plan_.actions[i];
+  const Keyframe& K = a.keyframe;
+  const int n_robots = static_cast<int>(w_.robots.size());
+  state_ = states_[i];
+  auto in_action = [&](int r) {
+    return std::find(a.robots.begin(), a.robots.end(), r) != a.robots.end();
+  };
+  // Robots freed earlier go where the keyframe has them (home).
+  for (int r = 0; r < n_robots; ++r) {
+    if (in_action(r) || state_.held[r] >= 0) continue;
+    if (!Return(i, r, K.q[r], false)) return false;
+  }
+  // Who grasps, which objects move and where to.
+  std::vector<int> graspers;
+  int grasped = a.objects.empty() ? -1 : a.objects[0];
+  PlanGrasp new_grasp;
+  if (a.type == ActionType::kPick || a.type == ActionType::kAddGrasp) {
+    graspers.push_back(a.robots[0]);
+    new_grasp = a.grasps[0].grasp;
+  } else if (a.type == ActionType::kHandover) {
+    graspers.push_back(a.robots[1]);
+    new_grasp = a.grasps[1].grasp;
+  }
+  const bool assemble = a.type == ActionType::kAssemble;
+  const Keyframe& target_kf = assemble && a.approach ? *a.approach : K;
+  struct Moving {
+    int node;
+    std::vector<int> holders;
+    Iso3 X_goal;
+  };
+  std::vector<Moving> moving;
+  for (const auto& [node, o] : state_.objects) {
+    const std::vector<int> holders = state_.Holders(node);
+    if (holders.empty()) continue;
+    const PlanObject* goal = FindObject(target_kf, node);
+    if (goal == nullptr) continue;
+    if (!SamePose(goal->X_WA, o.X_WA)) moving.push_back({node, holders, goal->X_WA});
+  }
+  // Robots that let go and stayed back off first.
+  for (int r : a.robots) {
+    if (released_[r] >= 0 && !Retreat(i, r)) return false;
+  }
+  for (const Moving& m : moving) {
+    for (int r : m.holders) {
+      if (released_[r] >= 0 && !Retreat(i, r)) return false;
+    }
+  }
+  // Lift what moves off the table.
+  for (const Moving& m : moving) {
+    if (grounded_.count(m.node) && !Lift(i, m.node, m.holders)) return false;
+  }
+  // The approach of each grasper, planned backwards from its grasp.
+  std::vector<std::vector<JointVector>> approaches(graspers.size());
+  std::vector<double> approach_len(graspers.size(), 0.0);
+  for (size_t k = 0; k < graspers.size(); ++k) {
+    const int r = graspers[k];
+    std::vector<double> openings = opening_;
+    openings[r] = GraspOpening(w_.robots[r], new_grasp);
+    const JointVector saved = cur_[r];
+    cur_[r] = K.q[r];
+    // The scene at the keyframe's object poses: the object to grasp where it will be.
+    PlanState at = state_;
+    for (const PlanObject& o : K.objects) {
+      if (auto it = at.objects.find(o.node); it != at.objects.end()) it->second.X_WA = o.X_WA;
+    }
+    std::swap(state_, at);
+    std::vector<int> carriers_now;
+    for (const Moving& m : moving) {
+      for (int h : m.holders) {
+        carriers_now.push_back(h);
+      }
+    }
+    std::vector<JointVector> saved_carriers;
+    for (int h : carriers_now) {
+      saved_carriers.push_back(cur_[h]);
+      cur_[h] = K.q[h];
+    }
+    auto set = SetScene(openings, {}, {}, {{r, grasped}});
+    if (!set) return false;
+    double len = 0.0;
+    std::vector<JointVector> back = BackOff(r, K.q[r], &len);
+    for (size_t c = 0; c < carriers_now.size(); ++c) cur_[carriers_now[c]] = saved_carriers[c];
+    std::swap(state_, at);
+    cur_[r] = saved;
+    if (back.empty()) {
+      return Fail(i, SegmentKind::kApproach, false,
+                  Name(r) + " cannot approach its grasp on " + NodeName(grasped) +
+                      " straight along the gripper axis: " + last_hit_);
+    }
+    std::reverse(back.begin(), back.end());
+    approaches[k] = std::move(back);
+    approach_len[k] = len;
+  }
+  // Where the carriers go before their final skill: the descent's top for a place.
+  std::vector<JointVector> descend;
+  if (a.type == ActionType::kPlace) {
+    const int r = a.robots[0];
+    const JointVector saved = cur_[r];
+    cur_[r] = K.q[r];
+    if (!SetScene(opening_, {}, {grasped})) return false;
+    const Iso3 X0 = Tcp(r, K.q[r]);
+    const double d = opt_.lift_m;
+    auto path = Track({r}, {K.q[r]}, {[X0, d](double s) {
+                        Iso3 X = X0;
+                        X.translation().z() += s * d;
+                        return X;
+                      }},
+                      std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m))));
+    const bool ok = !path.empty() && PathClear({r}, path);
+    cur_[r] = saved;
+    if (!ok) {
+      return Fail(i, SegmentKind::kDescend, false,
+                  Name(r) + " cannot set " + NodeName(grasped) +
+                      " down straight onto the table at its placement: " + last_hit_);
+    }
+    for (auto it = path.rbegin(); it != path.rend(); ++it) descend.push_back((*it)[0]);
+  }
+  // Free motion of the graspers and of single-handed carriers; two-handed carries after.
+  std::vector<int> free_robots;
+  std::vector<JointVector> free_goals;
+  std::vector<int> free_objects;
+  std::vector<const Moving*> carries;
+  for (size_t k = 0; k < graspers.size(); ++k) {
+    free_robots.push_back(graspers[k]);
+    free_goals.push_back(approaches[k].front());
+  }
+  for (const Moving& m : moving) {
+    if (m.holders.size() > 1) {
+      carries.push_back(&m);
+      continue;
+    }
+    const int r = m.holders[0];
+    free_robots.push_back(r);
+    free_goals.push_back(a.type == ActionType::kPlace ? descend.front() : target_kf.q[r]);
+    free_objects.push_back(m.node);
+  }
+  if (grasped >= 0 && !graspers.empty()) free_objects.push_back(grasped);
+  // Two-handed carries first: the object reaches its pose, then the others come to it.
+  for (const Moving* m : carries) {
+    std::vector<JointVector> goal_q;
+    for (int r : m->holders) goal_q.push_back(target_kf.q[r]);
+    if (!Carry(i, m->node, m->holders, m->X_goal, goal_q, target_kf, assemble && a.approach))
+      return false;
+  }
+  {
+    // Open each grasper to its grasp before it moves in.
+    for (int r : graspers) opening_[r] = GraspOpening(w_.robots[r], new_grasp);
+    std::vector<size_t> order(free_robots.size());
+    for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(),
+              [&](size_t x, size_t y) { return free_robots[x] < free_robots[y]; });
+    std::vector<int> robots;
+    std::vector<JointVector> goals;
+    for (size_t k : order) {
+      robots.push_back(free_robots[k]);
+      goals.push_back(free_goals[k]);
+    }
+    if (!Free(i, true, robots, goals, free_objects)) return false;
+  }
+  // The final skills.
+  if (a.type == ActionType::kPlace) {
+    GeoSegment seg;
+    seg.kind = SegmentKind::kDescend;
+    seg.action = i;
+    seg.main = true;
+    seg.robots = {a.robots[0]};
+    seg.objects = {grasped};
+    for (const JointVector& q : descend) seg.waypoints.push_back({q});
+    seg.skill_length_m = opt_.lift_m;
+    seg.skill_speed_mps = opt_.skill_speed_mps;
+    Push(std::move(seg));
+  }
+  if (assemble && a.approach) {
+    const int m_node = a.objects[0];
+    const int b_node = a.objects[1];
+    std::vector<int> inserters = state_.Holders(m_node);
+    std::vector<JointVector> q0;
+    std::vector<std::function<Iso3(double)>> targets;
+    double len = 0.0;
+    for (int r : inserters) {
+      q0.push_back(cur_[r]);
+      const Iso3 Xa = Tcp(r, cur_[r]);
+      const Iso3 Xb = Tcp(r, K.q[r]);
+      len = std::max(len, (Xb.translation() - Xa.translation()).norm());
+      targets.push_back([Xa, Xb](double s) {
+        Iso3 X = Xa;
+        X.translation() = (1 - s) * Xa.translation() + s * Xb.translation();
+        return X;
+      });
+    }
+    const int steps = std::max(2, static_cast<int>(std::ceil(len / opt_.cartesian_step_m)));
+    std::vector<JointVector> goals;
+    for (int r : inserters) goals.push_back(K.q[r]);
+    auto path = Track(inserters, q0, targets, steps, &goals);
+    bool ok = !path.empty();
+    for (size_t k = 0; ok && k < inserters.size(); ++k) {
+      const int r = inserters[k];
+      if ((path.back()[k] - K.q[r]).cwiseAbs().maxCoeff() > kMaxSnap) {
+        ok = KeyframeAccepts(r, path.back()[k], K, {{m_node, b_node}});
+        if (ok) Rebranch(r, i, false, K.q[r], path.back()[k]);
+      }
+      if (ok) path.back()[k] = K.q[r];
+    }
+    if (ok) {
+      if (!SetScene(opening_, {{m_node, b_node}}, {m_node})) return false;
+      ok = PathClear(inserters, path);
+    }
+    if (!ok) {
+      return Fail(i, SegmentKind::kInsert, false,
+                  "the insertion of " + NodeName(m_node) + " into " + NodeName(b_node) +
+                      " is not a collision-free straight move: " + last_hit_);
+    }
+    GeoSegment seg;
+    seg.kind = SegmentKind::kInsert;
+    seg.action = i;
+    seg.main = true;
+    seg.robots = inserters;
+    seg.objects = {m_node, b_node};
+    seg.waypoints = std::move(path);
+    seg.skill_length_m = len;
+    seg.skill_speed_mps = opt_.insert_speed_mps;
+    Push(std::move(seg));
+  }
+  for (size_t k = 0; k < graspers.size(); ++k) {
+    GeoSegment seg;
+    seg.kind = SegmentKind::kApproach;
+    seg.action = i;
+    seg.main = true;
+    seg.robots = {graspers[k]};
+    seg.objects = {grasped};
+    for (const JointVector& q : approaches[k]) seg.waypoints.push_back({q});
+    seg.skill_length_m = approach_len[k];
+    seg.skill_speed_mps = opt_.skill_speed_mps;
+    Push(std::move(seg));
+  }
+  // Every robot is now at the keyframe.
+  for (int r = 0; r < n_robots; ++r) {
+    if ((cur_[r] - K.q[r]).cwiseAbs().maxCoeff() > 1e-6) {
+      return Fail(i, SegmentKind::kFree, false,
+                  "internal: " + Name(r) + " is not at the keyframe of action " +
+                      std::to_string(i + 1) + " after its motion");
+    }
+    cur_[r] = K.q[r];
+  }
+  GeoSegment grip;
+  grip.kind = SegmentKind::kGrip;
+  grip.action = i;
+  grip.main = true;
+  grip.robots = a.robots;
+  std::sort(grip.robots.begin(), grip.robots.end());
+  grip.objects = a.objects;
+  grip.waypoints.push_back({});
+  for (int r : grip.robots) grip.waypoints[0].push_back(K.q[r]);
+  grip.hold_s = assemble || a.type == ActionType::kRelease ? opt_.grip_s / 2 : opt_.grip_s;
+  Push(std::move(grip));
+  // Effects.
+  switch (a.type) {
+    case ActionType::kPick:
+    case ActionType::kAddGrasp:
+      break;
+    case ActionType::kPlace:
+      grounded_.insert(grasped);
+      released_[a.robots[0]] = grasped;
+      break;
+    case ActionType::kRelease:
+      released_[a.robots[0]] = grasped;
+      break;
+    case ActionType::kHandover:
+      released_[a.robots[0]] = grasped;
+      break;
+    case ActionType::kAssemble: {
+      const bool base_grounded = grounded_.count(a.objects[1]) > 0;
+      grounded_.erase(a.objects[0]);
+      grounded_.erase(a.objects[1]);
+      if (base_grounded) grounded_.insert(a.objects[2]);
+      break;
+    }
+  }
+  return true;
+}
+
+Result<std::vector<GeoSegment>> Builder::Run() {
+  auto scene = MotionScene::Build(w_);
+  if (!scene) return std::unexpected(scene.error());
+  scene_ = std::move(*scene);
+  rng_.seed(Mix(seed_, 0x6d6f74));
+  const int n_robots = static_cast<int>(w_.robots.size());
+  if (static_cast<int>(plan_.initial.q.size()) != n_robots) {
+    return wrap::Fail(ErrorCode::kInvalidInput, "the plan's robots do not match the project's");
+  }
+  states_ = ReplayPlanStates(plan_);
+  cur_ = plan_.initial.q;
+  opening_.assign(n_robots, -1.0);
+  released_.assign(n_robots, -1);
+  for (const PlanObject& o : plan_.initial.objects) {
+    if (o.resting) grounded_.insert(o.node);
+  }
+  for (size_t i = 0; i < plan_.actions.size(); ++i) {
+    if (ctx_.cancelled()) return wrap::Fail(ErrorCode::kCancelled, "motion planning cancelled");
+    if (!Action(static_cast<int>(i))) {
+      if (cancelled_ || ctx_.cancelled()) {
+        return wrap::Fail(ErrorCode::kCancelled, "motion planning cancelled");
+      }
+      return std::vector<GeoSegment>{};
+    }
+  }
+  // Everyone home at the end.
+  const int last = static_cast<int>(plan_.actions.size()) - 1;
+  state_ = states_.back();
+  for (int r = 0; r < n_robots; ++r) {
+    if (!Return(std::max(last, 0), r, plan_.initial.q[r], false)) {
+      if (cancelled_ || ctx_.cancelled()) {
+        return wrap::Fail(ErrorCode::kCancelled, "motion planning cancelled");
+      }
+      return std::vector<GeoSegment>{};
+    }
+  }
+  return std::move(out_);
+}
+
+}  // namespace
+
+std::string_view ToString(SegmentKind kind) { return kKindNames[static_cast<int>(kind)]; }
+
+Result<std::vector<GeoSegment>> PlanGeometricMotion(const TaskWorld& world, Plan& plan,
+                                                    const MotionOptions& options, int effort,
+                                                    std::uint64_t seed, MotionCache& cache,
+                                                    RunContext& ctx, MotionFailure* failure) {
+  Builder builder(world, plan, options, effort, seed, cache, ctx, failure);
+  return builder.Run();
+}
+
+}  // namespace wrap

@@ -1,0 +1,90 @@
+// Geometric motion of a task plan (paper §IV-E): the free-space paths between keyframes, planned
+// in the composite space of the robots that move, and the contact-rich skills (approach and
+// retreat along the gripper axis, lift and descent at the table, insertion along the mating axis,
+// two-handed carries) as straight Cartesian moves. Untimed; retime.h times them.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "core/result.h"
+#include "core/run_context.h"
+#include "motion/scene.h"
+#include "task/plan.h"
+#include "task/world.h"
+
+namespace wrap {
+
+/// What a segment is.
+enum class SegmentKind { kFree, kApproach, kRetreat, kLift, kDescend, kInsert, kCarry, kGrip };
+
+/// "free", "approach", "retreat", "lift", "descend", "insert", "carry", "grip".
+std::string_view ToString(SegmentKind kind);
+
+/// Options of the geometric motion.
+struct MotionOptions {
+  /// Joint-space resolution of every collision check along a motion: consecutive checked states
+  /// differ by at most this in every joint [rad]. The trajectory check uses the same.
+  double resolution_rad = 0.02;
+  double segment_time_s = 0.5;  ///< RRT-Connect budget per free segment at effort 0 [s].
+  int max_effort = 3;           ///< Effort levels 0..max_effort; the budget doubles per level.
+  double approach_m = 0.04;     ///< Straight approach to (and retreat from) a grasp [m].
+  double lift_m = 0.02;         ///< Straight lift off (and descent onto) the table [m].
+  double cartesian_step_m = 0.004;  ///< Spacing of IK samples along a straight move [m].
+  double skill_speed_mps = 0.05;    ///< TCP speed of approach, retreat, lift, descent [m/s].
+  double insert_speed_mps = 0.02;   ///< TCP speed of an insertion [m/s].
+  double carry_speed_mps = 0.10;    ///< Object speed of a two-handed carry [m/s].
+  double grip_s = 0.4;              ///< A gripper closing or opening at a keyframe [s].
+  /// Shortcut attempts per free path.
+  int shortcut_attempts = 60;
+};
+
+/// A segment of the geometric motion.
+struct GeoSegment {
+  SegmentKind kind = SegmentKind::kFree;
+  int action = -1;           ///< Action it leads to (the last action for the final returns).
+  bool main = false;         ///< Part of the action itself (not a robot returning home).
+  std::vector<int> robots;   ///< Robots that move (or grip), ascending.
+  std::vector<int> objects;  ///< Objects it carries, approaches, releases or inserts.
+  /// Waypoints: waypoints[k][i] is robot robots[i] at waypoint k; straight joint motion between.
+  std::vector<std::vector<JointVector>> waypoints;
+  std::vector<double> openings;  ///< Every robot's finger opening during it (-1 fully open).
+  double skill_length_m = 0.0;   ///< Cartesian length of a skill (sets its duration) [m].
+  double skill_speed_mps = 0.0;  ///< Its TCP or object speed [m/s]; 0 for free paths.
+  double hold_s = 0.0;           ///< Grip: how long the robots stay [s].
+  /// World boxes swept by its robots' bodies and what they carry, and of its objects, grown by
+  /// the sampling bound: two segments whose boxes do not meet can run at the same time.
+  std::vector<Aabb> boxes;
+};
+
+/// Why the geometric motion of a plan could not be made.
+struct MotionFailure {
+  int action = -1;       ///< Action of the segment.
+  std::string segment;   ///< Its kind.
+  bool suspend = false;  ///< True when more effort may find it (a path search ran out of time).
+  std::string message;   ///< The segment and the reason, in words.
+};
+
+/// Solved free paths of one plan, kept across effort levels (segment index -> waypoints).
+struct MotionCache {
+  std::vector<std::vector<std::vector<JointVector>>> free_paths;  ///< Empty where not solved.
+};
+
+/// The geometric motion of `plan` at effort level `effort`. Keyframes stay, except where a straight
+/// two-handed carry or an insertion reaches the keyframe's TCP pose on another IK solution that is
+/// collision-free and clear of the other robots there: that solution replaces the robot's joints
+/// at that keyframe and the following ones where it stood still (validate the plan again). On
+/// success the segments in execution order (the plan's order; the schedule may overlap them);
+/// otherwise `failure` says which segment failed. `cache` keeps solved free paths between calls
+/// for the same plan. Deterministic for a given seed when no path search runs out of time.
+/// Fails with kCancelled when ctx is cancelled and kInvalidInput when the plan does not fit the
+/// world.
+Result<std::vector<GeoSegment>> PlanGeometricMotion(const TaskWorld& world, Plan& plan,
+                                                    const MotionOptions& options, int effort,
+                                                    std::uint64_t seed, MotionCache& cache,
+                                                    RunContext& ctx, MotionFailure* failure);
+
+}  // namespace wrap

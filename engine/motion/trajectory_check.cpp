@@ -1,0 +1,474 @@
+#include "motion/trajectory_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <set>
+#include <utility>
+
+#include "geometry/convex_hull.h"
+#include "robot/kinematics.h"
+
+namespace wrap {
+
+namespace {
+
+std::string Num(double v, const char* fmt = "%.3f") {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), fmt, v);
+  return buf;
+}
+
+// An object as the check replays it.
+struct Thing {
+  bool resting = true;
+  Iso3 X_WA = Iso3::Identity();
+  std::vector<int> holders;  // ascending
+};
+
+// Who holds what, replayed from the actions whose moments have passed.
+struct Replay {
+  std::map<int, Thing> things;
+  std::vector<int> held;
+  std::vector<PlanGrasp> grasp;
+};
+
+const PlanObject* KeyframeObject(const Keyframe& k, int node) {
+  for (const PlanObject& o : k.objects) {
+    if (o.node == node) return &o;
+  }
+  return nullptr;
+}
+
+void Apply(Replay& s, const PlanAction& a) {
+  auto drop = [&](int node, int r) {
+    auto& h = s.things[node].holders;
+    h.erase(std::remove(h.begin(), h.end(), r), h.end());
+    s.held[r] = -1;
+  };
+  auto take = [&](int node, int r, const PlanGrasp& g) {
+    auto& h = s.things[node].holders;
+    if (std::find(h.begin(), h.end(), r) == h.end()) h.push_back(r);
+    std::sort(h.begin(), h.end());
+    s.held[r] = node;
+    s.grasp[r] = g;
+  };
+  const int o = a.objects.empty() ? -1 : a.objects[0];
+  switch (a.type) {
+    case ActionType::kPick:
+      take(o, a.robots[0], a.grasps[0].grasp);
+      s.things[o].resting = false;
+      break;
+    case ActionType::kAddGrasp:
+      take(o, a.robots[0], a.grasps[0].grasp);
+      break;
+    case ActionType::kPlace:
+    case ActionType::kRelease: {
+      drop(o, a.robots[0]);
+      Thing& t = s.things[o];
+      if (const PlanObject* k = KeyframeObject(a.keyframe, o)) t.X_WA = k->X_WA;
+      if (a.type == ActionType::kPlace || t.holders.empty()) t.resting = true;
+      break;
+    }
+    case ActionType::kHandover:
+      drop(o, a.robots[0]);
+      take(o, a.robots[1], a.grasps[1].grasp);
+      break;
+    case ActionType::kAssemble: {
+      const int m = a.objects[0], b = a.objects[1], result = a.objects[2];
+      Thing t;
+      t.resting = s.things[b].resting;
+      if (const PlanObject* k = KeyframeObject(a.keyframe, b)) t.X_WA = k->X_WA;
+      for (int node : {m, b}) {
+        for (int r : s.things[node].holders) t.holders.push_back(r);
+      }
+      std::sort(t.holders.begin(), t.holders.end());
+      for (int r : t.holders) s.held[r] = result;
+      s.things.erase(m);
+      s.things.erase(b);
+      s.things[result] = t;
+      break;
+    }
+  }
+}
+
+class Checker {
+ public:
+  Checker(const TaskWorld& w, const Plan& p, const TrajectoryCheckOptions& o)
+      : w_(w), plan_(p), opt_(o) {}
+  TrajectoryCheck Run();
+
+ private:
+  void Issue(double t, int robot, std::string check, std::string message) {
+    out_.issues.push_back({t, robot, std::move(check), std::move(message)});
+  }
+  std::string Robot(int r) const { return "'" + w_.robots[r].name + "'"; }
+  std::string Node(int n) const { return "'" + plan_.nodes[n] + "'"; }
+  void CheckKnots(int r);
+  void CheckEvents();
+  void CheckDense();
+  Cell* CellFor(const std::vector<double>& openings);
+
+  const TaskWorld& w_;
+  const Plan& plan_;
+  const TrajectoryCheckOptions& opt_;
+  TrajectoryCheck out_;
+  std::map<std::vector<long long>, Cell> cells_;
+  std::vector<std::vector<Vec3>> hull_;  // per part, in the part frame
+};
+
+void Checker::CheckKnots(int r) {
+  const RobotTrajectory& tr = plan_.trajectories[r];
+  const Chain& chain = w_.robots[r].chain;
+  const int dof = static_cast<int>(chain.joints.size());
+  const auto& k = tr.knots;
+  for (size_t i = 0; i < k.size(); ++i) {
+    if (k[i].q.size() != dof || k[i].qd.size() != dof) {
+      Issue(k[i].t, r, "format", "knot " + std::to_string(i) + " has the wrong number of joints");
+      return;
+    }
+    if (i > 0 && !(k[i].t >= k[i - 1].t)) {
+      Issue(k[i].t, r, "format", "knot times decrease at knot " + std::to_string(i));
+      return;
+    }
+  }
+  if (k.front().t != 0.0) Issue(k.front().t, r, "format", "the first knot is not at 0 s");
+  for (size_t i = 0; i < k.size(); ++i) {
+    for (int j = 0; j < dof; ++j) {
+      const Joint& J = chain.joints[j];
+      const double v = std::abs(k[i].qd[j]) / J.max_velocity;
+      out_.max_velocity_ratio = std::max(out_.max_velocity_ratio, v);
+      if (v > 1.0 + opt_.limit_slack) {
+        Issue(k[i].t, r, "limits",
+              "joint " + std::to_string(j + 1) + " moves at " + Num(std::abs(k[i].qd[j])) +
+                  " rad/s, above its limit " + Num(J.max_velocity));
+      }
+      if (k[i].q[j] < J.lower - 1e-9 || k[i].q[j] > J.upper + 1e-9) {
+        Issue(k[i].t, r, "limits",
+              "joint " + std::to_string(j + 1) + " at " + Num(k[i].q[j]) + " is outside [" +
+                  Num(J.lower) + ", " + Num(J.upper) + "]");
+      }
+    }
+    if (i == 0) continue;
+    const double dt = k[i].t - k[i - 1].t;
+    if (dt <= 0.0) {
+      if ((k[i].q - k[i - 1].q).cwiseAbs().maxCoeff() > 1e-9) {
+        Issue(k[i].t, r, "continuity", "the position jumps at knot " + std::to_string(i));
+      }
+      continue;
+    }
+    for (int j = 0; j < dof; ++j) {
+      const Joint& J = chain.joints[j];
+      const double acc = (k[i].qd[j] - k[i - 1].qd[j]) / dt;
+      const double ratio = std::abs(acc) / J.max_acceleration;
+      out_.max_acceleration_ratio = std::max(out_.max_acceleration_ratio, ratio);
+      if (ratio > 1.0 + opt_.limit_slack) {
+        Issue(k[i - 1].t, r, "limits",
+              "joint " + std::to_string(j + 1) + " accelerates at " + Num(std::abs(acc)) +
+                  " rad/s^2, above its limit " + Num(J.max_acceleration));
+      }
+      const double expected = k[i - 1].q[j] + 0.5 * (k[i - 1].qd[j] + k[i].qd[j]) * dt;
+      if (std::abs(expected - k[i].q[j]) > 1e-6 * (1.0 + std::abs(k[i].q[j] - k[i - 1].q[j]))) {
+        Issue(k[i].t, r, "continuity",
+              "joint " + std::to_string(j + 1) + " reaches " + Num(k[i].q[j], "%.6f") +
+                  " at knot " + std::to_string(i) + " but its velocities lead to " +
+                  Num(expected, "%.6f"));
+      }
+      // A turning point inside the stretch must stay within the limits too.
+      if (acc != 0.0) {
+        const double tau = -k[i - 1].qd[j] / acc;
+        if (tau > 0.0 && tau < dt) {
+          const double q = k[i - 1].q[j] + k[i - 1].qd[j] * tau + 0.5 * acc * tau * tau;
+          if (q < J.lower - 1e-9 || q > J.upper + 1e-9) {
+            Issue(k[i - 1].t + tau, r, "limits",
+                  "joint " + std::to_string(j + 1) + " turns at " + Num(q) + ", outside its limits");
+          }
+        }
+      }
+    }
+  }
+  if ((k.front().q - plan_.initial.q[r]).cwiseAbs().maxCoeff() > opt_.joint_tolerance ||
+      k.front().qd.cwiseAbs().maxCoeff() > 0.0) {
+    Issue(0.0, r, "start", "does not start at rest at its initial joints");
+  }
+  if ((k.back().q - plan_.initial.q[r]).cwiseAbs().maxCoeff() > opt_.joint_tolerance ||
+      k.back().qd.cwiseAbs().maxCoeff() > 0.0) {
+    Issue(k.back().t, r, "end", "does not end at rest at its initial (home) joints");
+  }
+}
+
+void Checker::CheckEvents() {
+  std::map<int, std::pair<double, int>> last_robot, last_object;  // -> (time, action)
+  for (size_t i = 0; i < plan_.actions.size(); ++i) {
+    const PlanAction& a = plan_.actions[i];
+    const std::string label = "action " + std::to_string(i + 1) + " (" + DescribeAction(plan_, a) + ")";
+    if (!(a.start_s >= 0.0) || !(a.end_s >= a.start_s)) {
+      Issue(a.end_s, -1, "event", label + " has no times (start_s, end_s)");
+      continue;
+    }
+    if (a.end_s > out_.makespan_s + 1e-9) {
+      Issue(a.end_s, -1, "event", label + " ends after the trajectories do");
+    }
+    for (size_t k = 0; k < a.robots.size(); ++k) {
+      const int r = a.robots[k];
+      const JointVector q = SampleTrajectory(plan_.trajectories[r], a.end_s);
+      const double off = (q - a.keyframe.q[r]).cwiseAbs().maxCoeff();
+      if (off > opt_.joint_tolerance) {
+        Issue(a.end_s, r, "event",
+              "is " + Num(off, "%.2e") + " rad away from its keyframe joints at the moment of " +
+                  label);
+      }
+      if (auto it = last_robot.find(r); it != last_robot.end() && it->second.first > a.end_s) {
+        Issue(a.end_s, r, "event",
+              label + " happens before action " + std::to_string(it->second.second + 1) +
+                  ", which comes earlier in the plan");
+      }
+      last_robot[r] = {a.end_s, static_cast<int>(i)};
+    }
+    for (int o : a.objects) {
+      if (auto it = last_object.find(o); it != last_object.end() && it->second.first > a.end_s) {
+        Issue(a.end_s, -1, "event",
+              label + " happens before action " + std::to_string(it->second.second + 1) +
+                  ", which comes earlier in the plan and involves " + Node(o));
+      }
+      last_object[o] = {a.end_s, static_cast<int>(i)};
+    }
+  }
+}
+
+Cell* Checker::CellFor(const std::vector<double>& openings) {
+  std::vector<long long> key;
+  for (double o : openings) key.push_back(o < 0.0 ? -1 : std::llround(o * 1e5));
+  if (auto it = cells_.find(key); it != cells_.end()) return &it->second;
+  CellDef def = w_.cell_def;
+  for (size_t r = 0; r < w_.robots.size(); ++r) {
+    if (openings[r] >= 0.0) {
+      def.robots[r].end_effector.collision =
+          EndEffectorShapesAt(w_.robots[r].end_effector, openings[r]);
+    }
+  }
+  CellOptions options;
+  options.objects_touch_table = false;
+  auto cell = Cell::Build(def, options);
+  if (!cell) {
+    Issue(-1, -1, "collision", "the check's cell does not build: " + cell.error().message);
+    return nullptr;
+  }
+  return &cells_.emplace(key, std::move(*cell)).first->second;
+}
+
+void Checker::CheckDense() {
+  const int n_robots = static_cast<int>(w_.robots.size());
+  const int n_parts = w_.num_parts;
+  for (int p = 0; p < n_parts; ++p) {
+    auto hull = ComputeConvexHull(w_.cell_def.objects[p].mesh);
+    hull_.push_back(hull ? hull->mesh.vertices : w_.cell_def.objects[p].mesh.vertices);
+  }
+  // Sample times: every knot, and in between so that no joint moves more than the resolution.
+  std::vector<double> times;
+  for (const RobotTrajectory& tr : plan_.trajectories) {
+    for (size_t i = 0; i < tr.knots.size(); ++i) {
+      times.push_back(tr.knots[i].t);
+      if (i == 0) continue;
+      const double dt = tr.knots[i].t - tr.knots[i - 1].t;
+      const double v = std::max(tr.knots[i].qd.cwiseAbs().maxCoeff(),
+                                tr.knots[i - 1].qd.cwiseAbs().maxCoeff());
+      const int n = static_cast<int>(std::ceil(v * dt / opt_.resolution_rad));
+      for (int s = 1; s < n; ++s) times.push_back(tr.knots[i - 1].t + dt * s / n);
+    }
+  }
+  for (const PlanAction& a : plan_.actions) times.push_back(a.end_s);
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end(),
+                          [](double x, double y) { return std::abs(x - y) < 1e-9; }),
+              times.end());
+  // Events in time order.
+  std::vector<int> events(plan_.actions.size());
+  for (size_t i = 0; i < events.size(); ++i) events[i] = static_cast<int>(i);
+  std::stable_sort(events.begin(), events.end(), [&](int x, int y) {
+    return plan_.actions[x].end_s < plan_.actions[y].end_s;
+  });
+  // Contact windows declared by the plan's skills.
+  struct Window {
+    double t0, t1;
+    int robot;  // -1: object pair
+    int a, b;
+  };
+  std::vector<Window> windows;
+  for (const MotionSegment& m : plan_.segments) {
+    if (m.kind == "insert" && m.objects.size() >= 2 && m.action >= 0) {
+      windows.push_back({m.start_s, plan_.actions[m.action].end_s, -1, m.objects[0], m.objects[1]});
+    } else if ((m.kind == "approach" || m.kind == "retreat") && !m.robots.empty()) {
+      for (int o : m.objects) windows.push_back({m.start_s, m.end_s, m.robots[0], o, -1});
+    }
+  }
+  Replay s;
+  s.held.assign(n_robots, -1);
+  s.grasp.resize(n_robots);
+  for (const PlanObject& o : plan_.initial.objects) s.things[o.node] = {o.resting, o.X_WA, {}};
+  size_t next_event = 0;
+  std::set<std::pair<int, int>> reported;
+  std::vector<std::vector<Iso3>> frames(n_robots);
+  std::vector<JointVector> q(n_robots);
+  std::vector<Iso3> X_WT(n_robots);
+  for (double t : times) {
+    while (next_event < events.size() && plan_.actions[events[next_event]].end_s <= t + 1e-12) {
+      Apply(s, plan_.actions[events[next_event]]);
+      ++next_event;
+    }
+    std::vector<double> openings(n_robots);
+    for (int r = 0; r < n_robots; ++r) {
+      q[r] = SampleTrajectory(plan_.trajectories[r], t);
+      openings[r] = OpeningAt(plan_.trajectories[r], t);
+      const TaskRobot& R = w_.robots[r];
+      X_WT[r] = TcpPose(R.chain, R.X_WB, q[r], R.end_effector.X_FT);
+    }
+    Cell* cell = CellFor(openings);
+    if (cell == nullptr) return;
+    ++out_.samples;
+    for (int r = 0; r < n_robots; ++r) {
+      frames[r].resize(w_.robots[r].chain.links.size());
+      ForwardKinematics(w_.robots[r].chain, w_.robots[r].X_WB, q[r], frames[r]);
+      cell->SetConfiguration(r, std::span<const double>(q[r].data(), q[r].size()), frames[r]);
+    }
+    CollisionWorld& cw = cell->world();
+    std::vector<int> node_of(n_parts, -1);
+    for (auto& [node, thing] : s.things) {
+      Iso3 X_WA = thing.X_WA;
+      if (!thing.resting && !thing.holders.empty()) {
+        const int c = thing.holders.front();
+        const PlanGrasp& g = s.grasp[c];
+        X_WA = X_WT[c] * (w_.X_AP[g.part] * g.X_PG).inverse();
+      }
+      for (int r : thing.holders) {
+        const PlanGrasp& g = s.grasp[r];
+        const Iso3 want = X_WA * w_.X_AP[g.part] * g.X_PG;
+        const double dp = (want.translation() - X_WT[r].translation()).norm();
+        const double dr = Eigen::AngleAxisd(want.linear().transpose() * X_WT[r].linear()).angle();
+        if (dp > opt_.grasp_tolerance_m || dr > opt_.grasp_tolerance_rad) {
+          if (reported.insert({-10 - r, node}).second) {
+            Issue(t, r, "grasp",
+                  "its TCP is " + Num(dp * 1000, "%.1f") + " mm / " + Num(dr, "%.3f") +
+                      " rad away from its grasp on " + Node(node) + ", which " +
+                      (thing.resting ? "rests" : "another robot carries"));
+          }
+        }
+      }
+      for (int p : w_.tree->nodes[node].parts) {
+        node_of[p] = node;
+        cell->SetObjectPose(p, X_WA * w_.X_AP[p]);
+      }
+    }
+    auto window = [&](int robot, int a, int b) {
+      for (const Window& wdw : windows) {
+        if (t < wdw.t0 - 1e-9 || t > wdw.t1 + 1e-9 || wdw.robot != robot) continue;
+        if (robot >= 0 && wdw.a == a) return true;
+        if (robot < 0 && ((wdw.a == a && wdw.b == b) || (wdw.a == b && wdw.b == a))) return true;
+      }
+      return false;
+    };
+    for (int p = 0; p < n_parts; ++p) {
+      const int node = node_of[p];
+      cell->SetObjectEnabled(p, node >= 0);
+      for (int o = p + 1; o < n_parts; ++o) {
+        const bool ok = node >= 0 && node_of[o] >= 0 &&
+                        (node == node_of[o] || window(-1, node, node_of[o]));
+        cell->SetObjectPairAllowed(p, o, ok);
+      }
+      bool table = false;
+      if (node >= 0) {
+        const Iso3& X = cw.pose(cell->object_body(p));
+        double lowest = std::numeric_limits<double>::infinity();
+        for (const Vec3& v : hull_[p]) lowest = std::min(lowest, (X * v).z());
+        table = lowest >= w_.table_top - opt_.table_tolerance_m;
+      }
+      cw.SetAllowed(cell->object_body(p), cell->table_body(), table);
+      for (int r = 0; r < n_robots; ++r) {
+        const bool holds = node >= 0 && s.held[r] == node;
+        cw.SetAllowed(cell->object_body(p), cell->end_effector_body(r),
+                      holds || (node >= 0 && window(r, node, -1)));
+      }
+    }
+    ++out_.collision_checks;
+    CollisionResult hit;
+    CollisionRequest request;
+    if (cell->InCollision(&hit, request)) {
+      const auto key = std::minmax(hit.first.body_a.value, hit.first.body_b.value);
+      if (reported.insert(key).second) {
+        Issue(t, cell->robot_of(hit.first.body_a), "collision",
+              "'" + cw.body_name(hit.first.body_a) + "' collides with '" +
+                  cw.body_name(hit.first.body_b) + "' (" + cell->Describe(hit.first) + ")");
+      }
+    }
+  }
+}
+
+TrajectoryCheck Checker::Run() {
+  const int n_robots = static_cast<int>(w_.robots.size());
+  for (int r = 0; r < n_robots; ++r) {
+    if (plan_.trajectories[r].knots.empty()) {
+      Issue(-1, r, "format", "has no knots");
+      return out_;
+    }
+    out_.makespan_s = std::max(out_.makespan_s, plan_.trajectories[r].knots.back().t);
+  }
+  for (int r = 0; r < n_robots; ++r) {
+    CheckKnots(r);
+    if (std::abs(plan_.trajectories[r].knots.back().t - out_.makespan_s) > 1e-9) {
+      Issue(plan_.trajectories[r].knots.back().t, r, "end",
+            "its trajectory ends before the others' (" + Num(out_.makespan_s) + " s)");
+    }
+  }
+  CheckEvents();
+  if (opt_.check_collisions && out_.issues.empty()) CheckDense();
+  out_.valid = out_.issues.empty();
+  return out_;
+}
+
+}  // namespace
+
+std::string FormatTrajectoryIssue(const Plan& plan, const TrajectoryIssue& issue) {
+  std::string out;
+  if (issue.t >= 0.0) out += "t=" + Num(issue.t, "%.2f") + " s: ";
+  if (issue.robot >= 0 && issue.robot < static_cast<int>(plan.robots.size())) {
+    out += plan.robots[issue.robot] + ": ";
+  }
+  return out + issue.check + ": " + issue.message;
+}
+
+Result<TrajectoryCheck> CheckTrajectories(const TaskWorld& world, const Plan& plan,
+                                          const TrajectoryCheckOptions& options) {
+  const int n_robots = static_cast<int>(world.robots.size());
+  if (plan.trajectories.empty()) {
+    return Fail(ErrorCode::kInvalidInput, "the plan has no trajectories (run motion planning)");
+  }
+  if (static_cast<int>(plan.trajectories.size()) != n_robots ||
+      static_cast<int>(plan.initial.q.size()) != n_robots) {
+    return Fail(ErrorCode::kInvalidInput, "the plan's trajectories do not match the robots");
+  }
+  for (int r = 0; r < n_robots; ++r) {
+    if (plan.trajectories[r].robot != r) {
+      return Fail(ErrorCode::kInvalidInput, "trajectory " + std::to_string(r) + " is for robot " +
+                                                std::to_string(plan.trajectories[r].robot));
+    }
+  }
+  for (const PlanAction& a : plan.actions) {
+    for (int r : a.robots) {
+      if (r < 0 || r >= n_robots) return Fail(ErrorCode::kInvalidInput, "a robot is out of range");
+    }
+    for (int o : a.objects) {
+      if (o < 0 || o >= world.num_nodes) {
+        return Fail(ErrorCode::kInvalidInput, "an object is out of range");
+      }
+    }
+  }
+  if (!(options.resolution_rad > 0.0)) {
+    return Fail(ErrorCode::kInvalidInput, "the resolution must be positive");
+  }
+  Checker checker(world, plan, options);
+  return checker.Run();
+}
+
+}  // namespace wrap

@@ -1,0 +1,143 @@
+#include "pipeline/pipeline.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "motion/motion.h"
+#include "task/world.h"
+
+namespace wrap {
+
+namespace {
+
+double Since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A task plan waiting for its motion.
+struct Candidate {
+  Plan plan;
+  MotionCache cache;
+  int effort = 0;
+  int order = 0;  // arrival
+};
+
+}  // namespace
+
+Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
+                          const Preprocessed& pre, const PipelineOptions& options,
+                          RunContext& ctx) {
+  auto first = PlanTask(project, check, pre, options.task, ctx);
+  if (!first) return first;
+  if (options.task_only || !first->stats.solved) return first;
+  auto world = BuildTaskWorld(project, check, pre, options.task.project_file);
+  if (!world) return std::unexpected(world.error());
+
+  std::vector<Candidate> queue;
+  int made = 1;
+  int suspensions = 0;
+  double t_kf = 0.0;
+  double t_mp = 0.0;
+  double t_retime = 0.0;
+  std::optional<Plan> fallback;  // the first task plan, returned when no motion is found
+  std::string last_failure;
+  const std::uint64_t seed = options.seed;
+  first->stats.seed = seed;
+
+  auto enqueue = [&](Plan plan) -> Result<void> {
+    if (options.optimize_keyframes) {
+      const auto t0 = std::chrono::steady_clock::now();
+      auto report = OptimizeKeyframes(*world, plan, options.keyframes, ctx);
+      t_kf += Since(t0);
+      if (!report) {
+        if (report.error().code == ErrorCode::kCancelled) return std::unexpected(report.error());
+        // Keep the keyframes as planned: they are valid.
+      }
+    }
+    if (!fallback) fallback = plan;
+    Candidate c;
+    c.plan = std::move(plan);
+    c.order = static_cast<int>(queue.size());
+    queue.push_back(std::move(c));
+    return {};
+  };
+  if (auto ok = enqueue(std::move(*first)); !ok) return std::unexpected(ok.error());
+
+  while (!ctx.ShouldStop()) {
+    // NextTaskPlan: another task plan once every queued plan has been suspended at least once.
+    bool all_suspended = !queue.empty();
+    for (const Candidate& c : queue) all_suspended = all_suspended && c.effort > 0;
+    if ((queue.empty() || all_suspended) && made < options.max_task_plans) {
+      TaskPlannerOptions task = options.task;
+      task.optimize = false;
+      RunContext sub(seed + 7919ULL * static_cast<std::uint64_t>(made));
+      sub.set_deadline(ctx.deadline());
+      sub.set_stop_token(ctx.stop_token());
+      ++made;
+      auto next = PlanTask(project, check, pre, task, sub);
+      if (!next) {
+        if (next.error().code == ErrorCode::kCancelled) return std::unexpected(next.error());
+      } else if (next->stats.solved) {
+        next->stats.seed = seed + 7919ULL * static_cast<std::uint64_t>(made - 1);
+        if (auto ok = enqueue(std::move(*next)); !ok) return std::unexpected(ok.error());
+      }
+      continue;
+    }
+    if (queue.empty()) break;
+    // SelectFairly: the least effort so far, the oldest first.
+    size_t pick = 0;
+    for (size_t k = 1; k < queue.size(); ++k) {
+      if (queue[k].effort < queue[pick].effort) pick = k;
+    }
+    Candidate& c = queue[pick];
+    auto attempt = PlanMotion(*world, c.plan, options.motion, c.effort,
+                              c.plan.stats.seed ^ 0x4d50ULL, c.cache, ctx);
+    if (!attempt) {
+      if (attempt.error().code == ErrorCode::kCancelled) return std::unexpected(attempt.error());
+      return std::unexpected(attempt.error());
+    }
+    t_mp += attempt->t_mp_s;
+    t_retime += attempt->t_retime_s;
+    if (attempt->solved) {
+      Plan plan = std::move(c.plan);
+      plan.stats.t_kf_s = t_kf;
+      plan.stats.t_mp_s = t_mp;
+      plan.stats.t_retime_s = t_retime;
+      plan.stats.motion_suspensions = suspensions;
+      plan.stats.task_plans = made;
+      return plan;
+    }
+    const MotionFailure& f = attempt->failure;
+    last_failure = "action " + std::to_string(f.action + 1) + ", " + f.segment + " segment: " +
+                   f.message;
+    if (std::getenv("WRAP_MOTION_DEBUG")) {
+      std::fprintf(stderr, "[motion] plan %d effort %d: %s%s\n", c.order, c.effort,
+                   last_failure.c_str(), f.suspend ? " (suspended)" : "");
+    }
+    if (f.suspend && c.effort < options.motion.max_effort) {
+      ++c.effort;  // Suspend: more effort later
+      ++suspensions;
+    } else {
+      queue.erase(queue.begin() + static_cast<long>(pick));
+    }
+  }
+  if (ctx.cancelled()) return Fail(ErrorCode::kCancelled, "planning cancelled");
+  Plan plan = std::move(*fallback);
+  plan.stats.solved = false;
+  plan.stats.t_kf_s = t_kf;
+  plan.stats.t_mp_s = t_mp;
+  plan.stats.t_retime_s = t_retime;
+  plan.stats.motion_suspensions = suspensions;
+  plan.stats.task_plans = made;
+  plan.stats.failure = "no motion for the task plan" + std::string(made > 1 ? "s" : "") +
+                       " found (" + std::to_string(made) + " tried" +
+                       (ctx.timed_out() ? ", time limit reached" : "") + "); last: " +
+                       (last_failure.empty() ? "none planned" : last_failure);
+  return plan;
+}
+
+}  // namespace wrap

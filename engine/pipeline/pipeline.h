@@ -1,0 +1,43 @@
+// The planner as one call (paper Algorithm 1, "High level search of WRAP"): task plans from the
+// task planner (NextTaskPlan), each with its keyframes optimised jointly, queued with an effort
+// level; the motion planner takes the queued plan with the least effort (SelectFairly), and a plan
+// whose free path search runs out of time is suspended and retried later with twice the budget,
+// while further task plans join the queue. The first plan with motion is returned.
+#pragma once
+
+#include <cstdint>
+
+#include "core/result.h"
+#include "core/run_context.h"
+#include "grasp/preprocess.h"
+#include "model/project.h"
+#include "model/validate.h"
+#include "motion/keyframe_opt.h"
+#include "motion/segments.h"
+#include "task/plan.h"
+#include "task/planner.h"
+
+namespace wrap {
+
+/// Options of PlanAssembly.
+struct PipelineOptions {
+  TaskPlannerOptions task;       ///< The task planner's.
+  MotionOptions motion;          ///< The motion planner's.
+  KeyframeOptOptions keyframes;  ///< Joint keyframe optimisation's.
+  bool task_only = false;        ///< Stop after the task plan (no keyframe optimisation, motion).
+  bool optimize_keyframes = true;  ///< Run the joint keyframe optimisation before motion.
+  int max_task_plans = 4;  ///< Task plans the loop may ask for (the first with ctx's generator).
+  /// The run's seed (ctx's): recorded in the stats; further task plans and the motion planner's
+  /// sampling derive their seeds from it.
+  std::uint64_t seed = 0;
+};
+
+/// Plans `project` end to end. The plan's stats say whether it was solved; when the task plan was
+/// found but no motion, solved is false and stats.failure names the action and segment that could
+/// not be planned and why (the plan keeps its keyframes). Stage times: the task planner's, "kf",
+/// "mp", "retime". Fails like PlanTask (kInvalidInput, kCancelled).
+Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
+                          const Preprocessed& pre, const PipelineOptions& options,
+                          RunContext& ctx);
+
+}  // namespace wrap
