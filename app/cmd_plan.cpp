@@ -7,8 +7,10 @@
 #include "load.h"
 #include "task/plan_json.h"
 #include "task/plan_validator.h"
+#include "motion/trajectory_check.h"
 #include "pipeline/pipeline.h"
 #include "task/planner.h"
+#include "task/world.h"
 
 namespace wrap::cli {
 

@@ -26,6 +26,7 @@ case "$mode" in
     "$BUILD_DIR/app/wrap" preprocess projects/stool.json -o out/stool/preprocess.json
     "$BUILD_DIR/app/wrap" plan projects/stool.json -o out/stool/plan.json --validate
     "$BUILD_DIR/app/wrap" render projects/stool.json -o out/stool/plan --plan out/stool/plan.json
+    "$BUILD_DIR/app/wrap" render projects/stool.json -o out/stool/motion --plan out/stool/plan.json --frames 12
     "$BUILD_DIR/app/wrap" render projects/stool.json -o out/stool --explode 0.4
     ;;
   test)

@@ -99,6 +99,14 @@ std::vector<double> Cumulative(const std::vector<Eigen::VectorXd>& path) {
   return cum;
 }
 
+// Every piece valid at the query's resolution.
+bool PathValid(const PathQuery& query, const std::vector<Eigen::VectorXd>& path, long long* checks) {
+  for (size_t i = 1; i < path.size(); ++i) {
+    if (!StraightMotionValid(query, path[i - 1], path[i], checks)) return false;
+  }
+  return true;
+}
+
 void Shortcut(const PathQuery& query, std::vector<Eigen::VectorXd>& path, long long* checks) {
   std::mt19937_64 rng(query.seed ^ 0x5c0ffee);
   for (int attempt = 0; attempt < query.shortcut_attempts && path.size() > 2; ++attempt) {
@@ -171,7 +179,9 @@ PathAnswer PlanPath(const PathQuery& query) {
     return out;
   }
   ++out.checks;
-  if (StraightMotionValid(query, query.start, query.goal, &out.checks)) {
+  PathQuery fine = query;
+  if (query.final_resolution > 0.0) fine.resolution = query.final_resolution;
+  if (StraightMotionValid(fine, query.start, query.goal, &out.checks)) {
     out.solved = true;
     out.path = {query.start, query.goal};
     return out;
@@ -215,21 +225,33 @@ PathAnswer PlanPath(const PathQuery& query) {
   ob::PlannerTerminationCondition ptc([&] {
     return std::chrono::steady_clock::now() >= deadline || (query.stop && query.stop());
   });
-  const ob::PlannerStatus status = planner->solve(ptc);
-  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
-    out.timed_out = !(query.stop && query.stop());
-    out.why = out.timed_out ? "RRT-Connect found no path within " +
-                                  std::to_string(query.time_limit_s).substr(0, 4) + " s"
-                            : "cancelled";
-    return out;
+  std::uint64_t attempt_seed = seed;
+  while (true) {
+    const ob::PlannerStatus status = planner->solve(ptc);
+    if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+      out.timed_out = !(query.stop && query.stop());
+      out.why = out.timed_out ? "RRT-Connect found no path within " +
+                                    std::to_string(query.time_limit_s).substr(0, 4) + " s"
+                              : "cancelled";
+      return out;
+    }
+    const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
+    out.path.clear();
+    for (size_t i = 0; i < path->getStateCount(); ++i) {
+      out.path.push_back(ToVector(path->getState(i), dim));
+    }
+    out.path.front() = query.start;
+    out.path.back() = query.goal;
+    if (PathValid(fine, out.path, &out.checks)) break;
+    // It grazes something between the states RRT-Connect checked: search again.
+    attempt_seed = attempt_seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    space->setStateSamplerAllocator([attempt_seed](const ob::StateSpace* s) -> ob::StateSamplerPtr {
+      return std::make_shared<SeededSampler>(s, attempt_seed);
+    });
+    planner->clear();
+    pdef->clearSolutionPaths();
   }
-  const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
-  for (size_t i = 0; i < path->getStateCount(); ++i) {
-    out.path.push_back(ToVector(path->getState(i), dim));
-  }
-  out.path.front() = query.start;
-  out.path.back() = query.goal;
-  Shortcut(query, out.path, &out.checks);
+  Shortcut(fine, out.path, &out.checks);
   out.solved = true;
   return out;
 }

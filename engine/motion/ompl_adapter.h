@@ -22,6 +22,9 @@ struct PathQuery {
   std::function<bool(const Eigen::VectorXd&)> valid;
   /// Motions are checked at states no farther apart than this in any coordinate [rad or m].
   double resolution = 0.02;
+  /// The returned path is checked at this finer resolution (shortcuts too); a path that fails
+  /// it is not returned. 0: the same as `resolution`.
+  double final_resolution = 0.0;
   double time_limit_s = 1.0;  ///< RRT-Connect's budget [s].
   std::uint64_t seed = 0;     ///< Seeds sampling and shortcutting (deterministic per seed).
   /// Checked while planning: true stops at once (cancellation).
@@ -47,8 +50,10 @@ bool StraightMotionValid(const PathQuery& query, const Eigen::VectorXd& a, const
 
 /// A path from query.start to query.goal: the straight motion when it is valid, else RRT-Connect
 /// (OMPL) within the time limit, then shortcutting (random pairs of points along the path joined
-/// by straight motions) and removal of waypoints whose neighbours see each other. Deterministic for
-/// a given seed when it does not run out of time.
+/// by straight motions) and removal of waypoints whose neighbours see each other; every piece of
+/// the result is valid at `final_resolution` (RRT-Connect is run again with a new seed, within
+/// the time limit, while its path is not). Deterministic for a given seed when it does not run out
+/// of time.
 PathAnswer PlanPath(const PathQuery& query);
 
 }  // namespace wrap

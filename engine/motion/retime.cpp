@@ -1,6 +1,8 @@
 #include "motion/retime.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -40,10 +42,18 @@ bool Overlap(const Aabb& a, const Aabb& b) {
   return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
 }
 
-bool BoxesMeet(const std::vector<Aabb>& a, const std::vector<Aabb>& b) {
-  for (const Aabb& x : a) {
-    for (const Aabb& y : b) {
-      if (Overlap(x, y)) return true;
+// Sweeps (per body: the whole, then runs) meet: some pair of bodies whose wholes overlap has a
+// pair of runs that overlap.
+bool SweepsMeet(const std::vector<std::vector<Aabb>>& a, const std::vector<std::vector<Aabb>>& b) {
+  for (const auto& x : a) {
+    for (const auto& y : b) {
+      if (x.empty() || y.empty() || !Overlap(x[0], y[0])) continue;
+      for (size_t i = 1; i < x.size(); ++i) {
+        if (!Overlap(x[i], y[0])) continue;
+        for (size_t j = 1; j < y.size(); ++j) {
+          if (Overlap(x[i], y[j])) return true;
+        }
+      }
     }
   }
   return false;
@@ -150,22 +160,31 @@ Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
   std::map<int, int> last_of_object;
   for (int j = 0; j < n_seg; ++j) {
     const GeoSegment& s = segments[j];
-    std::vector<char> dep(j, 0);
+    std::vector<char> dep(j, 0);  // 1 robot, 2 object, 3 sweep
     for (int r : s.robots) {
       if (last_of_robot[r] >= 0) dep[last_of_robot[r]] = 1;
     }
     for (int o : s.objects) {
-      if (auto it = last_of_object.find(o); it != last_of_object.end()) dep[it->second] = 1;
+      if (auto it = last_of_object.find(o); it != last_of_object.end() && !dep[it->second]) {
+        dep[it->second] = 2;
+      }
     }
     for (int i = 0; i < j; ++i) {
-      if (!dep[i] && BoxesMeet(segments[i].boxes, s.boxes)) dep[i] = 1;
+      if (!dep[i] && SweepsMeet(segments[i].sweep, s.sweep)) dep[i] = 3;
     }
     double t = 0.0;
+    int binding = -1;
     for (int i = 0; i < j; ++i) {
       if (dep[i]) {
+        if (end[i] > t) binding = i;
         t = std::max(t, end[i]);
         ++out.dependencies;
       }
+    }
+    if (std::getenv("WRAP_MOTION_DEBUG")) {
+      std::fprintf(stderr, "[sched] %d %s a%d waits for %d (%s)\n", j,
+                   std::string(ToString(s.kind)).c_str(), s.action + 1, binding,
+                   binding < 0 ? "-" : (dep[binding] == 1 ? "robot" : dep[binding] == 2 ? "object" : "sweep"));
     }
     start[j] = t;
     end[j] = t + timed[j].duration;

@@ -201,8 +201,9 @@ void MotionScene::SetRobot(int robot, const JointVector& q) {
   cell_->SetConfiguration(robot, std::span<const double>(q.data(), q.size()), frames_[robot]);
 }
 
-bool MotionScene::Collides(std::span<const int> robots) {
+bool MotionScene::Collides(std::span<const int> robots, double margin_m) {
   CollisionRequest request;
+  request.margin_m = margin_m;
   if (!robots.empty()) {
     request.group_mask = std::uint64_t{1} << kCellObjectGroup;
     for (int r : robots) {

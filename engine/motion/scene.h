@@ -59,9 +59,9 @@ class MotionScene {
 
   /// Moves robot r (and what it carries).
   void SetRobot(int robot, const JointVector& q);
-  /// True when anything collides; with `robots` given only pairs that involve one of these robots
-  /// or an object are tested.
-  bool Collides(std::span<const int> robots = {});
+  /// True when anything collides (or comes closer than `margin_m`); with `robots` given only
+  /// pairs that involve one of these robots or an object are tested.
+  bool Collides(std::span<const int> robots = {}, double margin_m = 0.0);
   /// World boxes of robot r's bodies (links, gripper) and of the parts it carries, appended.
   void AppendBoxes(int robot, std::vector<Aabb>& out);
   /// World boxes of the parts of `node` where they are now.

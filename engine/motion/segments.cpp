@@ -28,6 +28,10 @@ constexpr double kMaxTrackJump = 0.25;
 // A tracked straight move must end this close to its keyframe's joints [rad]; farther, it has
 // reached another IK solution of the same TCP pose, which replaces the keyframe's when valid.
 constexpr double kMaxSnap = 0.05;
+// Skills and the final free paths are checked this many times finer than the resolution, so
+// that the dense check of the timed motion, sampling other points of the same straight pieces
+// at the resolution, meets no grazing contact that the planner's samples stepped over.
+constexpr int kRefine = 8;
 // Least distance between two robots at a keyframe, as the task planner keeps it [m].
 constexpr double kMinClearance = 0.005;
 
@@ -174,30 +178,45 @@ void Builder::Push(GeoSegment seg) {
 void Builder::Sweep(GeoSegment& seg) {
   // Samples no farther apart than kSweepStep in the sum of joint changes: with links at most
   // kLever from their joints, a body point between two samples lies within kSweepMargin of one.
-  constexpr double kSweepStep = 0.03;   // [rad]
-  constexpr double kLever = 1.5;        // [m]
+  // Per body: its whole sweep, then the sweeps of runs of kChunk samples.
+  constexpr double kSweepStep = 0.03;  // [rad]
+  constexpr double kLever = 1.5;       // [m]
   constexpr double kSweepMargin = 0.5 * kSweepStep * kLever + 0.01;
+  constexpr int kChunk = 6;
   if (!SetScene(seg.openings)) return;
-  std::vector<Aabb> boxes;
+  std::vector<std::vector<Aabb>> sweep;  // per body: [0] all, then chunks
   std::vector<Aabb> sample;
-  auto add = [&](bool first) {
+  int count = 0;
+  auto merge = [](Aabb& into, const Aabb& b) {
+    into.min = into.min.cwiseMin(b.min);
+    into.max = into.max.cwiseMax(b.max);
+  };
+  auto add = [&] {
     sample.clear();
     for (int r : seg.robots) scene_.AppendBoxes(r, sample);
     for (int node : seg.objects) {
       if (state_.objects.count(node)) scene_.AppendObjectBoxes(node, sample);
     }
-    if (first || boxes.size() != sample.size()) {
-      boxes.insert(boxes.end(), sample.begin(), sample.end());
+    if (sweep.size() != sample.size()) {  // first sample (or a body appeared: start over)
+      sweep.assign(sample.size(), {});
+      for (size_t b = 0; b < sample.size(); ++b) sweep[b] = {sample[b], sample[b]};
+      count = 1;
       return;
     }
+    const bool fresh = count % kChunk == 0;
     for (size_t b = 0; b < sample.size(); ++b) {
-      boxes[b].min = boxes[b].min.cwiseMin(sample[b].min);
-      boxes[b].max = boxes[b].max.cwiseMax(sample[b].max);
+      merge(sweep[b][0], sample[b]);
+      if (fresh) {
+        sweep[b].push_back(sample[b]);
+      } else {
+        merge(sweep[b].back(), sample[b]);
+      }
     }
+    ++count;
   };
   const auto& wp = seg.waypoints;
   for (size_t i = 0; i < seg.robots.size(); ++i) scene_.SetRobot(seg.robots[i], wp[0][i]);
-  add(true);
+  add();
   for (size_t k = 1; k < wp.size(); ++k) {
     double l1 = 0.0;
     for (size_t i = 0; i < seg.robots.size(); ++i) l1 += (wp[k][i] - wp[k - 1][i]).cwiseAbs().sum();
@@ -207,14 +226,16 @@ void Builder::Sweep(GeoSegment& seg) {
       for (size_t i = 0; i < seg.robots.size(); ++i) {
         scene_.SetRobot(seg.robots[i], wp[k - 1][i] + t * (wp[k][i] - wp[k - 1][i]));
       }
-      add(false);
+      add();
     }
   }
-  for (Aabb& b : boxes) {
-    b.min.array() -= kSweepMargin;
-    b.max.array() += kSweepMargin;
+  for (auto& boxes : sweep) {
+    for (Aabb& b : boxes) {
+      b.min.array() -= kSweepMargin;
+      b.max.array() += kSweepMargin;
+    }
   }
-  seg.boxes = std::move(boxes);
+  seg.sweep = std::move(sweep);
 }
 
 int Builder::UrBranch(int robot, const JointVector& q) const {
@@ -240,7 +261,9 @@ std::vector<std::vector<JointVector>> Builder::Track(
   std::vector<std::vector<JointVector>> out(steps + 1, std::vector<JointVector>(robots.size()));
   NumericIkOptions ik;
   ik.restarts = 0;
-  ik.max_iterations = 60;
+  ik.max_iterations = 100;
+  ik.position_tolerance_m = 5e-4;  // within the validators' grasp tolerance (2 mm)
+  ik.rotation_tolerance_rad = 5e-3;
   for (size_t i = 0; i < robots.size(); ++i) {
     const TaskRobot& r = w_.robots[robots[i]];
     JointVector q = q0[i];
@@ -263,14 +286,32 @@ std::vector<std::vector<JointVector>> Builder::Track(
         NumericIkRequest req;
         req.X_BT = X_BT;
         req.X_FT = r.end_effector.X_FT;
-        req.seeds = {q};
+        // From the last sample, and from it nudged away from the joint limits (an arm stuck at a
+        // limit finds the way round through its redundancy).
+        JointVector centred = q;
+        for (int j = 0; j < q.size(); ++j) {
+          centred[j] += 0.15 * (0.5 * (r.chain.joints[j].lower + r.chain.joints[j].upper) - q[j]);
+        }
+        req.seeds = {q, centred};
         // A redundant arm drifts toward its goal joints where it has a choice.
         req.reference = goals ? JointVector(q0[i] + s * ((*goals)[i] - q0[i])) : q;
         auto sol = SolveNumericIk(r.chain, req, rng_, ik);
-        if (!sol) return {};
+        if (!sol) {
+          if (std::getenv("WRAP_MOTION_DEBUG")) {
+            std::fprintf(stderr, "[track] %s step %d/%d: %s\n", r.name.c_str(), k, steps,
+                         sol.error().message.c_str());
+          }
+          return {};
+        }
         next = sol->q;
       }
-      if ((next - q).cwiseAbs().maxCoeff() > kMaxTrackJump) return {};
+      if ((next - q).cwiseAbs().maxCoeff() > kMaxTrackJump) {
+        if (std::getenv("WRAP_MOTION_DEBUG")) {
+          std::fprintf(stderr, "[track] %s step %d/%d: jump %.3f\n", r.name.c_str(), k, steps,
+                       (next - q).cwiseAbs().maxCoeff());
+        }
+        return {};
+      }
       q = next;
       out[k][i] = q;
     }
@@ -286,7 +327,8 @@ bool Builder::PathClear(const std::vector<int>& robots,
     for (size_t i = 0; i < robots.size(); ++i) {
       span = std::max(span, (waypoints[k][i] - waypoints[prev][i]).cwiseAbs().maxCoeff());
     }
-    const int steps = std::max(1, static_cast<int>(std::ceil(span / opt_.resolution_rad)));
+    const int steps =
+        std::max(1, static_cast<int>(std::ceil(span * kRefine / opt_.resolution_rad)));
     for (int s = (k == 0 ? steps : 1); s <= steps; ++s) {
       const double t = static_cast<double>(s) / steps;
       for (size_t i = 0; i < robots.size(); ++i) {
@@ -308,7 +350,7 @@ bool Builder::PathClear(const std::vector<int>& robots,
 std::vector<JointVector> Builder::BackOff(int robot, const JointVector& q, double* length) {
   const Iso3 X0 = Tcp(robot, q);
   const Vec3 axis = X0.linear().col(2);
-  for (double d : {opt_.approach_m, opt_.approach_m / 2, opt_.approach_m / 4}) {
+  for (double d : {opt_.approach_m, opt_.approach_m / 2, opt_.approach_m / 4, opt_.approach_m / 8}) {
     const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
     auto target = [X0, axis, d](double s) {
       Iso3 X = X0;
@@ -370,127 +412,180 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
   seg.kind = SegmentKind::kFree;
   seg.action = action;
   seg.main = main;
-  seg.robots = movers;
   seg.objects = objects;
   seg.openings = opening_;
-  if (!cache_.free_paths[index].empty()) {
-    seg.waypoints = cache_.free_paths[index];
-    Push(std::move(seg));
-    return true;
+  if (const MotionCache::Path& c = cache_.free_paths[index]; !c.waypoints.empty()) {
+    // Reuse a path solved at a lower effort when it is the same query.
+    bool same = true;
+    for (size_t i = 0; i < movers.size() && same; ++i) {
+      const auto it = std::find(c.robots.begin(), c.robots.end(), movers[i]);
+      same = it != c.robots.end();
+      if (same) {
+        const size_t j = static_cast<size_t>(it - c.robots.begin());
+        same = Same(c.waypoints.front()[j], cur_[movers[i]]) &&
+               Same(c.waypoints.back()[j], targets[i]);
+      }
+    }
+    if (same) {
+      seg.robots = c.robots;
+      seg.waypoints = c.waypoints;
+      Push(std::move(seg));
+      return true;
+    }
   }
   if (!SetScene(opening_)) return false;
-  PathQuery query;
-  int dim = 0;
-  for (int r : movers) dim += static_cast<int>(w_.robots[r].chain.joints.size());
-  query.lower.resize(dim);
-  query.upper.resize(dim);
-  query.start.resize(dim);
-  query.goal.resize(dim);
-  int k = 0;
-  for (size_t i = 0; i < movers.size(); ++i) {
-    const Chain& chain = w_.robots[movers[i]].chain;
-    for (size_t j = 0; j < chain.joints.size(); ++j, ++k) {
-      query.start[k] = cur_[movers[i]][j];
-      query.goal[k] = targets[i][j];
-      // Samples within half a turn beyond the ends (joints of +-2 pi would wrap in vain).
-      const double lo = std::min(query.start[k], query.goal[k]) - M_PI;
-      const double hi = std::max(query.start[k], query.goal[k]) + M_PI;
-      query.lower[k] = std::max(chain.joints[j].lower, lo);
-      query.upper[k] = std::min(chain.joints[j].upper, hi);
+  // One query in the composite space of `who` (goals `to`).
+  auto plan = [&](const std::vector<int>& who, const std::vector<JointVector>& to,
+                  std::vector<std::vector<JointVector>>* path) {
+    PathQuery query;
+    int dim = 0;
+    for (int r : who) dim += static_cast<int>(w_.robots[r].chain.joints.size());
+    query.lower.resize(dim);
+    query.upper.resize(dim);
+    query.start.resize(dim);
+    query.goal.resize(dim);
+    int k = 0;
+    for (size_t i = 0; i < who.size(); ++i) {
+      const Chain& chain = w_.robots[who[i]].chain;
+      for (size_t j = 0; j < chain.joints.size(); ++j, ++k) {
+        query.start[k] = cur_[who[i]][j];
+        query.goal[k] = to[i][j];
+        // Samples within half a turn beyond the ends (joints of +-2 pi would wrap in vain).
+        const double lo = std::min(query.start[k], query.goal[k]) - M_PI;
+        const double hi = std::max(query.start[k], query.goal[k]) + M_PI;
+        query.lower[k] = std::max(chain.joints[j].lower, lo);
+        query.upper[k] = std::min(chain.joints[j].upper, hi);
+      }
     }
-  }
-  auto split = [&](const Eigen::VectorXd& x) {
-    std::vector<JointVector> qs(movers.size());
-    int o = 0;
-    for (size_t i = 0; i < movers.size(); ++i) {
-      const int n = static_cast<int>(w_.robots[movers[i]].chain.joints.size());
-      qs[i] = x.segment(o, n);
-      o += n;
+    auto split = [&](const Eigen::VectorXd& x) {
+      std::vector<JointVector> qs(who.size());
+      int o = 0;
+      for (size_t i = 0; i < who.size(); ++i) {
+        const int n = static_cast<int>(w_.robots[who[i]].chain.joints.size());
+        qs[i] = x.segment(o, n);
+        o += n;
+      }
+      return qs;
+    };
+    query.valid = [&](const Eigen::VectorXd& x) {
+      const std::vector<JointVector> qs = split(x);
+      for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], qs[i]);
+      return !scene_.Collides(who);
+    };
+    query.resolution = opt_.resolution_rad;
+    query.time_limit_s = opt_.segment_time_s * std::pow(2.0, effort_);
+    query.seed = Mix(seed_, static_cast<std::uint64_t>(index) * 2 + (who.size() > movers.size()));
+    query.stop = [this] { return ctx_.ShouldStop(); };
+    query.shortcut_attempts = opt_.shortcut_attempts;
+    const auto t_query = std::chrono::steady_clock::now();
+    query.final_resolution = query.resolution / kRefine;
+    const PathAnswer answer = PlanPath(query);
+    for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], cur_[who[i]]);
+    if (std::getenv("WRAP_MOTION_DEBUG")) {
+      std::fprintf(stderr, "[free] action %d robots %zu: %s, %lld checks, %.2f s, %zu waypoints\n",
+                   action + 1, who.size(), answer.solved ? "solved" : answer.why.c_str(),
+                   answer.checks,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t_query)
+                       .count(),
+                   answer.path.size());
     }
-    return qs;
+    if (answer.solved) {
+      for (const Eigen::VectorXd& x : answer.path) path->push_back(split(x));
+    }
+    return answer;
   };
-  query.valid = [&](const Eigen::VectorXd& x) {
-    const std::vector<JointVector> qs = split(x);
-    for (size_t i = 0; i < movers.size(); ++i) scene_.SetRobot(movers[i], qs[i]);
-    return !scene_.Collides(movers);
-  };
-  query.resolution = opt_.resolution_rad;
-  query.time_limit_s = opt_.segment_time_s * std::pow(2.0, effort_);
-  query.seed = Mix(seed_, static_cast<std::uint64_t>(index));
-  query.stop = [this] { return ctx_.ShouldStop(); };
-  query.shortcut_attempts = opt_.shortcut_attempts;
-  const auto t_query = std::chrono::steady_clock::now();
-  const PathAnswer answer = PlanPath(query);
-  if (std::getenv("WRAP_MOTION_DEBUG") && !answer.solved) {
-    std::mt19937_64 g(1);
-    std::uniform_real_distribution<double> u(-0.1, 0.1);
-    int ok_s = 0, ok_g = 0;
-    for (int k = 0; k < 200; ++k) {
-      Eigen::VectorXd d(dim);
-      for (int j = 0; j < dim; ++j) d[j] = u(g);
-      ok_s += query.valid(query.start + d);
-      ok_g += query.valid(query.goal + d);
+  std::vector<std::vector<JointVector>> path;
+  PathAnswer answer = plan(movers, targets, &path);
+  std::vector<int> who = movers;
+  if (!answer.solved && answer.timed_out && effort_ > 0 && !ctx_.ShouldStop()) {
+    // The idle robots (free, not in this segment) may step aside and come back.
+    std::vector<int> all = movers;
+    std::vector<JointVector> to = targets;
+    for (int r = 0; r < static_cast<int>(w_.robots.size()); ++r) {
+      if (state_.held[r] < 0 && released_[r] < 0 &&
+          std::find(movers.begin(), movers.end(), r) == movers.end()) {
+        all.push_back(r);
+        to.push_back(cur_[r]);
+      }
     }
-    std::fprintf(stderr, "[free] local freedom: start %d/200, goal %d/200\n", ok_s, ok_g);
-    CollisionResult hit;
-    const std::vector<JointVector> qs = split(query.goal);
-    for (size_t i = 0; i < movers.size(); ++i) scene_.SetRobot(movers[i], qs[i]);
-  }
-  if (std::getenv("WRAP_MOTION_DEBUG")) {
-    std::fprintf(stderr, "[free] action %d robots %zu: %s, %lld checks, %.2f s, %zu waypoints\n",
-                 action + 1, movers.size(), answer.solved ? "solved" : answer.why.c_str(),
-                 answer.checks,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t_query).count(),
-                 answer.path.size());
+    if (all.size() > movers.size()) {
+      std::vector<size_t> order(all.size());
+      for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+      std::sort(order.begin(), order.end(), [&](size_t x, size_t y) { return all[x] < all[y]; });
+      std::vector<int> sorted;
+      std::vector<JointVector> sorted_to;
+      for (size_t k : order) {
+        sorted.push_back(all[k]);
+        sorted_to.push_back(to[k]);
+      }
+      answer = plan(sorted, sorted_to, &path);
+      who = sorted;
+    }
   }
   if (!answer.solved) {
     if (ctx_.cancelled()) cancelled_ = true;
-    std::string who;
-    for (int r : movers) who += (who.empty() ? "" : ", ") + Name(r);
+    std::string names;
+    for (int r : movers) names += (names.empty() ? "" : ", ") + Name(r);
     return Fail(action, SegmentKind::kFree, answer.timed_out,
-                "no collision-free path for " + who + " toward action " +
+                "no collision-free path for " + names + " toward action " +
                     std::to_string(action + 1) + ": " + answer.why);
   }
-  for (const Eigen::VectorXd& x : answer.path) seg.waypoints.push_back(split(x));
-  cache_.free_paths[index] = seg.waypoints;
+  seg.robots = who;
+  seg.waypoints = std::move(path);
+  cache_.free_paths[index] = {seg.robots, seg.waypoints};
   Push(std::move(seg));
   return true;
 }
 
 bool Builder::Lift(int action, int node, const std::vector<int>& holders) {
   if (!SetScene(opening_, {}, {node})) return false;
-  std::vector<JointVector> q0;
-  std::vector<std::function<Iso3(double)>> targets;
-  const double d = opt_.lift_m;
-  for (int r : holders) {
-    q0.push_back(cur_[r]);
-    const Iso3 X0 = Tcp(r, cur_[r]);
-    targets.push_back([X0, d](double s) {
-      Iso3 X = X0;
-      X.translation().z() += s * d;
-      return X;
-    });
+  // Straight up; else back along the first holder's approach axis when that leaves the table
+  // upward; else up and sideways; else a shorter lift.
+  const Vec3 back = -Tcp(holders[0], cur_[holders[0]]).linear().col(2);
+  std::vector<std::pair<Vec3, double>> moves = {{Vec3::UnitZ(), opt_.lift_m}};
+  if (back.z() > 0.3) moves.push_back({back, opt_.lift_m / back.z()});
+  for (const Vec3 side : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0)}) {
+    moves.push_back({(side + Vec3::UnitZ()).normalized(), opt_.lift_m * std::sqrt(2.0)});
   }
-  const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
-  auto path = Track(holders, q0, targets, steps);
-  if (path.empty()) last_hit_ = "no IK solution along the line";
-  if (path.empty() || !PathClear(holders, path)) {
-    return Fail(action, SegmentKind::kLift, false,
-                "the holders of " + NodeName(node) + " cannot lift it straight up off the table: " +
-                    last_hit_);
+  moves.push_back({Vec3::UnitZ(), opt_.lift_m / 2});
+  std::string why;
+  for (const auto& [dir, d] : moves) {
+    std::vector<JointVector> q0;
+    std::vector<std::function<Iso3(double)>> targets;
+    for (int r : holders) {
+      q0.push_back(cur_[r]);
+      const Iso3 X0 = Tcp(r, cur_[r]);
+      targets.push_back([X0, d = d, dir = dir](double s) {
+        Iso3 X = X0;
+        X.translation() += s * d * dir;
+        return X;
+      });
+    }
+    const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
+    auto path = Track(holders, q0, targets, steps);
+    if (path.empty()) {
+      why = "no IK solution along the line";
+      continue;
+    }
+    if (!PathClear(holders, path)) {
+      why = last_hit_;
+      continue;
+    }
+    GeoSegment seg;
+    seg.kind = SegmentKind::kLift;
+    seg.action = action;
+    seg.main = true;
+    seg.robots = holders;
+    seg.objects = {node};
+    seg.waypoints = std::move(path);
+    seg.skill_length_m = d;
+    seg.skill_speed_mps = opt_.skill_speed_mps;
+    Push(std::move(seg));
+    grounded_.erase(node);
+    return true;
   }
-  GeoSegment seg;
-  seg.kind = SegmentKind::kLift;
-  seg.action = action;
-  seg.main = true;
-  seg.robots = holders;
-  seg.objects = {node};
-  seg.waypoints = std::move(path);
-  seg.skill_length_m = d;
-  seg.skill_speed_mps = opt_.skill_speed_mps;
-  Push(std::move(seg));
-  grounded_.erase(node);
-  return true;
+  return Fail(action, SegmentKind::kLift, false,
+              "the holders of " + NodeName(node) + " cannot lift it off the table: " + why);
 }
 
 bool Builder::Carry(int action, int node, const std::vector<int>& holders, const Iso3& X_goal,
@@ -785,17 +880,47 @@ bool Builder::Action(int i) {
   {
     // Open each grasper to its grasp before it moves in.
     for (int r : graspers) opening_[r] = GraspOpening(w_.robots[r], new_grasp);
-    std::vector<size_t> order(free_robots.size());
-    for (size_t k = 0; k < order.size(); ++k) order[k] = k;
-    std::sort(order.begin(), order.end(),
-              [&](size_t x, size_t y) { return free_robots[x] < free_robots[y]; });
-    std::vector<int> robots;
-    std::vector<JointVector> goals;
-    for (size_t k : order) {
-      robots.push_back(free_robots[k]);
-      goals.push_back(free_goals[k]);
+    // One robot after another (prioritised): the carriers bring their objects, then the
+    // graspers come to them. Each search is in one arm's space; the schedule lets the moves
+    // overlap in time where their sweeps allow. When that fails, all of them at once in their
+    // composite space.
+    const size_t n_graspers = graspers.size();
+    const size_t saved_out = out_.size();
+    const std::vector<JointVector> saved_cur = cur_;
+    const int saved_index = free_index_;
+    bool ok = true;
+    for (size_t pass = 0; pass < 2 && ok; ++pass) {
+      for (size_t k = 0; k < free_robots.size() && ok; ++k) {
+        const bool is_grasper = k < n_graspers;
+        if (is_grasper != (pass == 1)) continue;
+        std::vector<int> objects;
+        if (is_grasper && grasped >= 0) objects.push_back(grasped);
+        if (!is_grasper) {
+          for (const Moving& m : moving) {
+            if (m.holders.size() == 1 && m.holders[0] == free_robots[k]) objects.push_back(m.node);
+          }
+        }
+        ok = Free(i, true, {free_robots[k]}, {free_goals[k]}, objects);
+      }
     }
-    if (!Free(i, true, robots, goals, free_objects)) return false;
+    if (!ok && free_robots.size() > 1) {
+      if (cancelled_ || ctx_.cancelled()) return false;
+      out_.resize(saved_out);
+      cur_ = saved_cur;
+      free_index_ = saved_index + static_cast<int>(free_robots.size());
+      std::vector<size_t> order(free_robots.size());
+      for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+      std::sort(order.begin(), order.end(),
+                [&](size_t x, size_t y) { return free_robots[x] < free_robots[y]; });
+      std::vector<int> robots;
+      std::vector<JointVector> goals;
+      for (size_t k : order) {
+        robots.push_back(free_robots[k]);
+        goals.push_back(free_goals[k]);
+      }
+      ok = Free(i, true, robots, goals, free_objects);
+    }
+    if (!ok) return false;
   }
   // The final skills.
   if (a.type == ActionType::kPlace) {

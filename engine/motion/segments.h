@@ -56,8 +56,9 @@ struct GeoSegment {
   double skill_speed_mps = 0.0;  ///< Its TCP or object speed [m/s]; 0 for free paths.
   double hold_s = 0.0;           ///< Grip: how long the robots stay [s].
   /// World boxes swept by its robots' bodies and what they carry, and of its objects, grown by
-  /// the sampling bound: two segments whose boxes do not meet can run at the same time.
-  std::vector<Aabb> boxes;
+  /// the sampling bound, per body: [0] the whole sweep, then the sweeps of consecutive runs of
+  /// samples. Two segments whose boxes do not meet can run at the same time.
+  std::vector<std::vector<Aabb>> sweep;
 };
 
 /// Why the geometric motion of a plan could not be made.
@@ -68,9 +69,13 @@ struct MotionFailure {
   std::string message;   ///< The segment and the reason, in words.
 };
 
-/// Solved free paths of one plan, kept across effort levels (segment index -> waypoints).
+/// Solved free paths of one plan, kept across effort levels (by free segment index).
 struct MotionCache {
-  std::vector<std::vector<std::vector<JointVector>>> free_paths;  ///< Empty where not solved.
+  struct Path {
+    std::vector<int> robots;                          ///< Robots of the composite space.
+    std::vector<std::vector<JointVector>> waypoints;  ///< Empty where not solved.
+  };
+  std::vector<Path> free_paths;  ///< By free segment index.
 };
 
 /// The geometric motion of `plan` at effort level `effort`. Keyframes stay, except where a straight

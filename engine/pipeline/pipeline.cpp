@@ -49,7 +49,7 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
   first->stats.seed = seed;
 
   auto enqueue = [&](Plan plan) -> Result<void> {
-    if (options.optimize_keyframes) {
+    if (options.optimize_keyframes && !std::getenv("WRAP_NO_KFOPT")) {
       const auto t0 = std::chrono::steady_clock::now();
       auto report = OptimizeKeyframes(*world, plan, options.keyframes, ctx);
       t_kf += Since(t0);

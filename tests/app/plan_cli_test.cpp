@@ -28,9 +28,19 @@ TEST(PlanCli, PlansValidatesAndWritesThePlan) {
   EXPECT_NE(r.out.find("1. "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("assembles 'leg1' onto 'seat'"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Validated:"), std::string::npos) << r.out;
+  // With motion (the default): the makespans, and the independent check of the trajectories.
+  EXPECT_NE(r.out.find("Motion: makespan"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Trajectories checked:"), std::string::npos) << r.out;
   std::ifstream in(out);
   const nlohmann::json plan = nlohmann::json::parse(in);
   EXPECT_EQ(plan["format"], "wrap-plan");
+  EXPECT_TRUE(plan["stats"]["motion"].get<bool>());
+  EXPECT_GT(plan["stats"]["makespan_s"].get<double>(), 0.0);
+  EXPECT_LE(plan["stats"]["makespan_s"].get<double>(),
+            plan["stats"]["makespan_sequential_s"].get<double>());
+  ASSERT_TRUE(plan.contains("trajectories"));
+  EXPECT_EQ(plan["trajectories"].size(), plan["robots"].size());
+  EXPECT_TRUE(plan["actions"][0].contains("end_s"));
   EXPECT_TRUE(plan["stats"]["solved"].get<bool>());
   EXPECT_EQ(plan["stats"]["cost"].get<int>(), static_cast<int>(plan["actions"].size()));
   for (const char* key : {"t_init_s", "t_grasp_s", "t_bwd_s", "t_lp_s", "t_fwd_s", "t_ik_s"}) {
@@ -47,7 +57,7 @@ TEST(PlanCli, SeedAndWrenchModeReachTheStats) {
   const fs::path dir = TempDir("seed");
   const fs::path out = dir / "plan.json";
   const CliRun r = Wrap({"plan", Project("half_stool"), "-o", out.string(), "--seed", "5",
-                         "--wrench", "gravity", "--force-scale", "0.5"});
+                         "--wrench", "gravity", "--force-scale", "0.5", "--task-only"});
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(out);
   const nlohmann::json plan = nlohmann::json::parse(in);
@@ -61,7 +71,8 @@ TEST(PlanCli, OptimizeRecordsTheCostOverTime) {
   const fs::path dir = TempDir("optimize");
   const fs::path out = dir / "plan.json";
   const CliRun r = Wrap({"plan", Project("half_stool"), "-o", out.string(), "--optimize",
-                         "--time-limit", "20", "--planner", "counting", "--validate"});
+                         "--time-limit", "20", "--planner", "counting", "--validate",
+                         "--task-only"});
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("Improved: cost "), std::string::npos) << r.out;
   std::ifstream in(out);
@@ -74,7 +85,7 @@ TEST(PlanCli, OptimizeRecordsTheCostOverTime) {
   EXPECT_EQ(st["cost_history"].back()[1], st["cost"]);
   EXPECT_LE(st["cost"].get<int>(), st["first_cost"].get<int>());
   for (const char* variant : {"optimistic", "flat", "exact", "fine"}) {
-    const CliRun v = Wrap({"plan", Project("half_stool"), "--planner", variant});
+    const CliRun v = Wrap({"plan", Project("half_stool"), "--planner", variant, "--task-only"});
     EXPECT_EQ(v.code, 0) << variant << ": " << v.out << v.err;
   }
 }
@@ -104,7 +115,7 @@ TEST(PlanCli, UnwritableOutputLeavesNothingAndExitsTwo) {
 TEST(PlanCli, ValidateReplaysAPlanFile) {
   const fs::path dir = TempDir("validate_plan");
   const fs::path good = dir / "plan.json";
-  ASSERT_EQ(Wrap({"plan", Project("half_stool"), "-o", good.string()}).code, 0);
+  ASSERT_EQ(Wrap({"plan", Project("half_stool"), "-o", good.string(), "--task-only"}).code, 0);
   const CliRun ok = Wrap({"validate", Project("half_stool"), "--plan", good.string()});
   EXPECT_EQ(ok.code, 0) << ok.out << ok.err;
   EXPECT_NE(ok.out.find("Validated:"), std::string::npos) << ok.out;
@@ -147,7 +158,7 @@ TEST(PlanCli, InfeasibleProjectExitsOneNamingTheStep) {
   }
   const fs::path file = dir / "vacuum_stool.json";
   std::ofstream(file) << p.dump(2);
-  const CliRun r = Wrap({"plan", file.string(), "--time-limit", "120"});
+  const CliRun r = Wrap({"plan", file.string(), "--time-limit", "120", "--task-only"});
   EXPECT_EQ(r.code, 1) << r.out << r.err;
   EXPECT_NE(r.err.find("seat+leg1"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("vacuum"), std::string::npos) << r.err;

@@ -1,1 +1,456 @@
+// Motion (paper §IV-E, §IV-F): the OMPL adapter on a toy space, retiming against hand-computed
+// trapezoids, the independent trajectory check catching planted faults, and every example project
+// planned end to end (task, keyframes, paths, skills, timing) with its trajectories passing the
+// dense check, its keyframes passing the plan validator, events synchronised and the asynchronous
+// makespan no longer than the sequential one; determinism; cancellation.
 #include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stop_token>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "../task/planning_fixture.h"
+#include "motion/ompl_adapter.h"
+#include "motion/retime.h"
+#include "motion/trajectory_check.h"
+#include "pipeline/pipeline.h"
+#include "robot/kinematics.h"
+#include "task/plan_json.h"
+
+namespace wrap {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// OMPL adapter
+
+// A 2-D square [0, 1]^2 with a wall at x in [0.45, 0.55] except a gap at y in [0.8, 0.9].
+PathQuery WallQuery() {
+  PathQuery q;
+  q.lower = Eigen::Vector2d(0, 0);
+  q.upper = Eigen::Vector2d(1, 1);
+  q.start = Eigen::Vector2d(0.1, 0.1);
+  q.goal = Eigen::Vector2d(0.9, 0.1);
+  q.valid = [](const Eigen::VectorXd& x) {
+    const bool in_wall = x[0] >= 0.45 && x[0] <= 0.55 && !(x[1] >= 0.8 && x[1] <= 0.9);
+    return !in_wall;
+  };
+  q.resolution = 0.005;
+  q.time_limit_s = 5.0;
+  q.seed = 7;
+  return q;
+}
+
+TEST(OmplAdapter, FindsThePathThroughTheGapAndEveryCheckedStateIsFree) {
+  const PathQuery q = WallQuery();
+  const PathAnswer a = PlanPath(q);
+  ASSERT_TRUE(a.solved) << a.why;
+  ASSERT_GE(a.path.size(), 3u);  // the straight line crosses the wall
+  EXPECT_TRUE(a.path.front().isApprox(q.start));
+  EXPECT_TRUE(a.path.back().isApprox(q.goal));
+  for (size_t i = 1; i < a.path.size(); ++i) {
+    EXPECT_TRUE(StraightMotionValid(q, a.path[i - 1], a.path[i])) << "piece " << i;
+  }
+  // Through the gap: some waypoint pair crosses x = 0.5 within y in [0.8, 0.9].
+  bool through_gap = false;
+  for (size_t i = 1; i < a.path.size(); ++i) {
+    const Eigen::VectorXd& p = a.path[i - 1];
+    const Eigen::VectorXd& r = a.path[i];
+    if ((p[0] - 0.5) * (r[0] - 0.5) <= 0.0 && p[0] != r[0]) {
+      const double y = p[1] + (0.5 - p[0]) / (r[0] - p[0]) * (r[1] - p[1]);
+      through_gap = through_gap || (y >= 0.8 && y <= 0.9);
+    }
+  }
+  EXPECT_TRUE(through_gap);
+}
+
+TEST(OmplAdapter, SameSeedSamePath) {
+  const PathAnswer a = PlanPath(WallQuery());
+  const PathAnswer b = PlanPath(WallQuery());
+  ASSERT_TRUE(a.solved && b.solved);
+  ASSERT_EQ(a.path.size(), b.path.size());
+  for (size_t i = 0; i < a.path.size(); ++i) EXPECT_EQ(a.path[i], b.path[i]);
+}
+
+TEST(OmplAdapter, StraightLineWhenFreeAndNamesABlockedGoal) {
+  PathQuery q = WallQuery();
+  q.goal = Eigen::Vector2d(0.3, 0.6);
+  PathAnswer a = PlanPath(q);
+  ASSERT_TRUE(a.solved);
+  EXPECT_EQ(a.path.size(), 2u);
+  q.goal = Eigen::Vector2d(0.5, 0.5);
+  a = PlanPath(q);
+  EXPECT_FALSE(a.solved);
+  EXPECT_FALSE(a.timed_out);
+  EXPECT_NE(a.why.find("goal"), std::string::npos) << a.why;
+}
+
+TEST(OmplAdapter, NoPathTimesOutAndStopsOnRequest) {
+  PathQuery q = WallQuery();
+  q.valid = [](const Eigen::VectorXd& x) { return x[0] < 0.45 || x[0] > 0.55; };  // no gap
+  q.time_limit_s = 0.2;
+  PathAnswer a = PlanPath(q);
+  EXPECT_FALSE(a.solved);
+  EXPECT_TRUE(a.timed_out);
+  q.time_limit_s = 30.0;
+  q.stop = [] { return true; };
+  const auto t0 = std::chrono::steady_clock::now();
+  a = PlanPath(q);
+  EXPECT_FALSE(a.solved);
+  EXPECT_FALSE(a.timed_out);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Example projects end to end
+
+struct Planned {
+  fs::path file;
+  LoadedProject lp;
+  std::optional<Preprocessed> pre;
+  std::optional<TaskWorld> world;
+  std::optional<Plan> plan;
+  std::string error;
+};
+
+Plan RunPipeline(const Planned& p, std::uint64_t seed, std::string* error) {
+  RunContext ctx(seed);
+  ctx.set_time_limit_s(120.0);
+  PipelineOptions options;
+  options.task.project_file = p.file;
+  options.seed = seed;
+  auto plan = PlanAssembly(*p.lp.project, p.lp.check, *p.pre, options, ctx);
+  if (!plan) {
+    *error = plan.error().message;
+    return {};
+  }
+  return *plan;
+}
+
+const Planned& PlanOnce(const std::string& name) {
+  static std::map<std::string, std::unique_ptr<Planned>> cache;
+  auto& slot = cache[name];
+  if (slot) return *slot;
+  slot = std::make_unique<Planned>();
+  Planned& p = *slot;
+  p.file = ProjectFile(name);
+  p.lp = LoadProject(p.file);
+  if (!p.lp.ok()) {
+    p.error = "does not load";
+    return p;
+  }
+  auto pre = PreprocessProject(p.lp, p.file);
+  if (!pre) {
+    p.error = pre.error().message;
+    return p;
+  }
+  p.pre = std::move(*pre);
+  auto world = BuildTaskWorld(*p.lp.project, p.lp.check, *p.pre, p.file);
+  if (!world) {
+    p.error = world.error().message;
+    return p;
+  }
+  p.world = std::move(*world);
+  p.plan = RunPipeline(p, 1, &p.error);
+  return p;
+}
+
+class ExampleMotion : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ExampleMotion, TrajectoriesPassTheIndependentChecks) {
+  const Planned& p = PlanOnce(GetParam());
+  ASSERT_TRUE(p.error.empty()) << p.error;
+  const Plan& plan = *p.plan;
+  ASSERT_TRUE(plan.stats.solved) << plan.stats.failure;
+  ASSERT_TRUE(plan.stats.motion);
+  ASSERT_EQ(plan.trajectories.size(), plan.robots.size());
+
+  // The keyframes (optimised, perhaps moved to other IK solutions) still pass the validator.
+  auto v = ValidatePlan(*p.lp.project, p.lp.check, plan, {}, p.file);
+  ASSERT_TRUE(v) << v.error().message;
+  EXPECT_TRUE(v->valid) << Issues(*v);
+
+  // Limits, continuity, start and end at home, events at their keyframes, dense collisions.
+  TrajectoryCheckOptions options;
+  auto check = CheckTrajectories(*p.world, plan, options);
+  ASSERT_TRUE(check) << check.error().message;
+  std::string issues;
+  for (const TrajectoryIssue& i : check->issues) issues += FormatTrajectoryIssue(plan, i) + "\n";
+  EXPECT_TRUE(check->valid) << issues;
+  EXPECT_GT(check->samples, 100);
+  EXPECT_LE(check->max_velocity_ratio, 1.0 + 1e-6);
+  EXPECT_LE(check->max_acceleration_ratio, 1.0 + 1e-6);
+  EXPECT_GT(check->max_velocity_ratio, 0.2);  // it does move, near its limits somewhere
+
+  // Asynchronous execution is never slower than one segment at a time.
+  EXPECT_GT(plan.stats.makespan_s, 0.0);
+  EXPECT_LE(plan.stats.makespan_s, plan.stats.makespan_sequential_s + 1e-9);
+  EXPECT_NEAR(check->makespan_s, plan.stats.makespan_s, 1e-9);
+
+  // Every action has its times; a handover's (and an assembly's) robots are at their keyframe
+  // joints at the same moment.
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    const PlanAction& a = plan.actions[i];
+    ASSERT_GE(a.start_s, 0.0) << i;
+    ASSERT_GE(a.end_s, a.start_s) << i;
+    for (int r : a.robots) {
+      const JointVector q = SampleTrajectory(plan.trajectories[r], a.end_s);
+      EXPECT_LT((q - a.keyframe.q[r]).cwiseAbs().maxCoeff(), 1e-6)
+          << "action " << i + 1 << " robot " << plan.robots[r];
+    }
+  }
+  // Trajectories start at the initial keyframe and end there (home).
+  for (size_t r = 0; r < plan.robots.size(); ++r) {
+    EXPECT_LT((plan.trajectories[r].knots.front().q - plan.initial.q[r]).cwiseAbs().maxCoeff(),
+              1e-9);
+    EXPECT_LT((plan.trajectories[r].knots.back().q - plan.initial.q[r]).cwiseAbs().maxCoeff(),
+              1e-9);
+  }
+  // Skills are marked with their own durations.
+  int skills = 0;
+  for (const MotionSegment& m : plan.segments) skills += m.kind != "free" && m.kind != "grip";
+  EXPECT_GT(skills, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Examples, ExampleMotion,
+                         ::testing::Values("stool", "half_stool", "chair", "cross",
+                                           "cross_openarm", "cube", "cube_2x2x3", "fabrica_beam",
+                                           "fabrica_car", "fabrica_plumbers_block"));
+
+TEST(Motion, SameSeedSameTrajectories) {
+  const Planned& p = PlanOnce("stool");
+  ASSERT_TRUE(p.error.empty()) << p.error;
+  ASSERT_TRUE(p.plan->stats.solved) << p.plan->stats.failure;
+  std::string error;
+  const Plan again = RunPipeline(p, 1, &error);
+  ASSERT_TRUE(error.empty()) << error;
+  ASSERT_EQ(again.trajectories.size(), p.plan->trajectories.size());
+  for (size_t r = 0; r < again.trajectories.size(); ++r) {
+    const auto& a = again.trajectories[r].knots;
+    const auto& b = p.plan->trajectories[r].knots;
+    ASSERT_EQ(a.size(), b.size()) << r;
+    for (size_t k = 0; k < a.size(); ++k) {
+      EXPECT_EQ(a[k].t, b[k].t);
+      EXPECT_EQ(a[k].q, b[k].q);
+    }
+  }
+  EXPECT_EQ(again.stats.makespan_s, p.plan->stats.makespan_s);
+}
+
+TEST(Motion, PlanJsonKeepsTheTrajectories) {
+  const Planned& p = PlanOnce("stool");
+  ASSERT_TRUE(p.error.empty() && p.plan->stats.solved);
+  const std::string text = SerializePlan(*p.plan);
+  auto back = ParsePlan(text, "stool.plan.json");
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_EQ(back->trajectories.size(), p.plan->trajectories.size());
+  ASSERT_EQ(back->segments.size(), p.plan->segments.size());
+  EXPECT_EQ(back->stats.makespan_s, p.plan->stats.makespan_s);
+  EXPECT_EQ(back->stats.makespan_sequential_s, p.plan->stats.makespan_sequential_s);
+  EXPECT_TRUE(back->stats.motion);
+  for (size_t i = 0; i < back->actions.size(); ++i) {
+    EXPECT_EQ(back->actions[i].end_s, p.plan->actions[i].end_s);
+  }
+  const auto& a = back->trajectories[1].knots;
+  const auto& b = p.plan->trajectories[1].knots;
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].t, b[k].t);
+    EXPECT_EQ(a[k].qd, b[k].qd);
+    EXPECT_EQ(a[k].opening_m, b[k].opening_m);
+  }
+  // The read plan passes the check too (nothing lost on the way).
+  auto check = CheckTrajectories(*p.world, *back, {});
+  ASSERT_TRUE(check);
+  EXPECT_TRUE(check->valid);
+}
+
+TEST(Motion, TaskOnlySkipsMotion) {
+  const Planned& p = PlanOnce("stool");
+  ASSERT_TRUE(p.error.empty());
+  RunContext ctx(1);
+  PipelineOptions options;
+  options.task.project_file = p.file;
+  options.task_only = true;
+  auto plan = PlanAssembly(*p.lp.project, p.lp.check, *p.pre, options, ctx);
+  ASSERT_TRUE(plan && plan->stats.solved);
+  EXPECT_FALSE(plan->stats.motion);
+  EXPECT_TRUE(plan->trajectories.empty());
+  EXPECT_EQ(plan->actions.front().end_s, -1.0);
+}
+
+TEST(Motion, CancelStopsWithinAFractionOfASecond) {
+  const Planned& p = PlanOnce("cross");
+  ASSERT_TRUE(p.error.empty());
+  std::stop_source stop;
+  RunContext ctx(1);
+  ctx.set_stop_token(stop.get_token());
+  PipelineOptions options;
+  options.task.project_file = p.file;
+  options.motion.segment_time_s = 30.0;  // long searches, if any
+  std::thread canceller([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(150));
+    stop.request_stop();
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  auto plan = PlanAssembly(*p.lp.project, p.lp.check, *p.pre, options, ctx);
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  canceller.join();
+  // Either it finished before the request or it stopped soon after it.
+  if (!plan) {
+    EXPECT_EQ(plan.error().code, ErrorCode::kCancelled);
+  }
+  EXPECT_LT(took, 0.15 + 0.5);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Retiming and the check, on hand-made motion of the stool's first robot
+
+class Handmade : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const Planned& p = PlanOnce("stool");
+    ASSERT_TRUE(p.error.empty() && p.plan->stats.solved);
+    planned_ = &p;
+  }
+  const Planned* planned_ = nullptr;
+};
+
+TEST_F(Handmade, TrapezoidTimesMatchHandComputedOnes) {
+  const TaskWorld& w = *planned_->world;
+  Plan plan = *planned_->plan;
+  const Chain& chain = w.robots[0].chain;
+  // Joint 1 moves d rad alone: v = max_velocity, a = max_acceleration.
+  const double v = chain.joints[0].max_velocity;
+  const double acc = chain.joints[0].max_acceleration;
+  for (double d : {0.05, 2.0}) {
+    GeoSegment seg;
+    seg.kind = SegmentKind::kFree;
+    seg.robots = {0};
+    JointVector q0 = plan.initial.q[0];
+    JointVector q1 = q0;
+    q1[0] += d;
+    seg.waypoints = {{q0}, {q1}, {q0}};
+    seg.openings.assign(plan.robots.size(), -1.0);
+    auto timing = Retime(w, plan, {seg});
+    ASSERT_TRUE(timing);
+    // Hand-computed: triangular when d < v^2 / a, else trapezoidal; there and back.
+    const double one = d < v * v / acc ? 2.0 * std::sqrt(d / acc) : d / v + v / acc;
+    EXPECT_NEAR(timing->makespan_s, 2.0 * one, 1e-9) << "d " << d;
+    EXPECT_NEAR(timing->makespan_sequential_s, 2.0 * one, 1e-9);
+    const RobotTrajectory& tr = timing->trajectories[0];
+    // Peak velocity at the middle of the first piece.
+    JointVector qd;
+    SampleTrajectory(tr, one / 2, &qd);
+    EXPECT_NEAR(std::abs(qd[0]), std::min(v, std::sqrt(d * acc)), 1e-9);
+    EXPECT_NEAR(SampleTrajectory(tr, one)[0], q1[0], 1e-12);
+  }
+  // A skill no faster than its speed: 4 cm at 5 cm/s takes 0.8 s however short its joint motion.
+  GeoSegment skill;
+  skill.kind = SegmentKind::kApproach;
+  skill.robots = {0};
+  JointVector q1 = plan.initial.q[0];
+  q1[5] += 0.01;
+  skill.waypoints = {{plan.initial.q[0]}, {q1}};
+  skill.skill_length_m = 0.04;
+  skill.skill_speed_mps = 0.05;
+  skill.openings.assign(plan.robots.size(), -1.0);
+  auto timing = Retime(w, plan, {skill});
+  ASSERT_TRUE(timing);
+  EXPECT_NEAR(timing->makespan_s, 0.8, 1e-9);
+}
+
+TEST_F(Handmade, IndependentRobotsOverlapAndSharedOnesWait) {
+  const TaskWorld& w = *planned_->world;
+  Plan plan = *planned_->plan;
+  auto wave = [&](int r, const Aabb& box) {
+    GeoSegment seg;
+    seg.kind = SegmentKind::kFree;
+    seg.robots = {r};
+    JointVector q1 = plan.initial.q[r];
+    q1[0] += 0.3;
+    seg.waypoints = {{plan.initial.q[r]}, {q1}, {plan.initial.q[r]}};
+    seg.openings.assign(plan.robots.size(), -1.0);
+    seg.sweep = {{box, box}};
+    return seg;
+  };
+  const Aabb left{Vec3(-1, -1, 0), Vec3(-0.5, 1, 1)};
+  const Aabb right{Vec3(0.5, -1, 0), Vec3(1, 1, 1)};
+  auto apart = Retime(w, plan, {wave(0, left), wave(1, right)});
+  ASSERT_TRUE(apart);
+  EXPECT_NEAR(apart->makespan_s, 0.5 * apart->makespan_sequential_s, 1e-9);
+  EXPECT_EQ(apart->dependencies, 0);
+  auto touching = Retime(w, plan, {wave(0, left), wave(1, left)});
+  ASSERT_TRUE(touching);
+  EXPECT_NEAR(touching->makespan_s, touching->makespan_sequential_s, 1e-9);
+  auto same_robot = Retime(w, plan, {wave(0, left), wave(0, right)});
+  ASSERT_TRUE(same_robot);
+  EXPECT_NEAR(same_robot->makespan_s, same_robot->makespan_sequential_s, 1e-9);
+}
+
+TEST_F(Handmade, TheCheckCatchesPlantedFaults) {
+  const TaskWorld& w = *planned_->world;
+  const Plan& good = *planned_->plan;
+  auto issues_of = [&](const Plan& plan, const std::string& kind) {
+    TrajectoryCheckOptions o;
+    o.check_collisions = kind == "collision";
+    auto c = CheckTrajectories(w, plan, o);
+    EXPECT_TRUE(c);
+    int n = 0;
+    for (const TrajectoryIssue& i : c->issues) n += i.check == kind;
+    return n;
+  };
+  // A knot twice as fast as it was: the velocity limit and continuity break.
+  {
+    Plan bad = good;
+    auto& knots = bad.trajectories[0].knots;
+    size_t k = 1;
+    while (k < knots.size() && knots[k].qd.cwiseAbs().maxCoeff() < 0.5) ++k;
+    ASSERT_LT(k, knots.size());
+    knots[k].qd *= 3.0;
+    EXPECT_GT(issues_of(bad, "limits"), 0);
+  }
+  // An action whose moment is moved: its robot is not at its keyframe then.
+  {
+    Plan bad = good;
+    bad.actions[0].end_s = 0.0;
+    bad.actions[0].start_s = 0.0;
+    EXPECT_GT(issues_of(bad, "event"), 0);
+  }
+  // A robot that does not come home.
+  {
+    Plan bad = good;
+    bad.trajectories[0].knots.back().q[0] += 0.1;
+    EXPECT_GT(issues_of(bad, "end"), 0);
+  }
+  // Robot 0 swung into the table at mid-plan: the dense check finds it.
+  {
+    Plan bad = good;
+    auto& knots = bad.trajectories[0].knots;
+    const JointVector home = knots.front().q;
+    JointVector down = home;
+    down[1] = 0.6;  // shoulder lift down into the table
+    std::vector<TrajectoryKnot> rebuilt = {knots.front()};
+    TrajectoryKnot k = knots.front();
+    k.t = 0.5;
+    rebuilt.push_back(k);
+    k.t = 1.0;
+    k.q = down;
+    rebuilt.push_back(k);
+    k.t = 1.5;
+    k.q = home;
+    rebuilt.push_back(k);
+    k.t = knots.back().t;
+    rebuilt.push_back(k);
+    knots = rebuilt;  // (teleports: the continuity check also objects)
+    EXPECT_GT(issues_of(bad, "collision"), 0);
+  }
+}
+
+}  // namespace
+}  // namespace wrap

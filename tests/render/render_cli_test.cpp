@@ -19,6 +19,8 @@
 #include <sstream>
 
 #include "model/validate.h"
+#include "render/render_job.h"
+#include "robot/kinematics.h"
 #include "render/image.h"
 #include "sim/scene.h"
 #include "task/plan_json.h"
@@ -294,6 +296,69 @@ fs::path WriteStoolPlan(const fs::path& dir) {
   const fs::path file = dir / "plan.json";
   EXPECT_TRUE(SavePlan(plan, file).has_value());
   return file;
+}
+
+// A plan with motion: robot 0 turns its first joint by 0.5 rad in 2 s and picks the seat at
+// t = 2 s. MotionState follows the trajectories (the seat rests until the pick, then rides with
+// the TCP), and --frames N draws N moments evenly in time.
+TEST(RenderCli, MotionFramesFollowTheTrajectories) {
+  const fs::path input = WriteStoolPlan(OutDir("motion_input"));
+  auto read = ReadPlanFile(input);
+  ASSERT_TRUE(read.has_value());
+  Plan plan = *read;
+  const LoadedProject loaded = LoadProject(Project("stool"));
+  ASSERT_TRUE(loaded.ok());
+  auto scene = BuildCellScene(*loaded.project, loaded.check, Project("stool"));
+  ASSERT_TRUE(scene.has_value());
+  const JointVector home = plan.initial.q[0];
+  JointVector turned = home;
+  turned[0] += 0.5;
+  plan.actions[0].keyframe.q[0] = turned;
+  plan.actions[0].start_s = 0.0;
+  plan.actions[0].end_s = 2.0;
+  plan.stats.makespan_s = 2.0;
+  for (size_t r = 0; r < plan.robots.size(); ++r) {
+    RobotTrajectory tr;
+    tr.robot = static_cast<int>(r);
+    const JointVector q0 = plan.initial.q[r];
+    const JointVector zero = JointVector::Zero(q0.size());
+    if (r == 0) {
+      // Constant acceleration between knots: 0 -> v at 1 s (mid-way), v -> 0 at 2 s.
+      const JointVector v = turned - home;
+      tr.knots = {{0.0, home, zero, -1.0}, {1.0, JointVector(0.5 * (home + turned)), v, -1.0},
+                  {2.0, turned, zero, 0.022}};
+    } else {
+      tr.knots = {{0.0, q0, zero, -1.0}, {2.0, q0, zero, -1.0}};
+    }
+    plan.trajectories.push_back(tr);
+  }
+  const AssemblyTree& tree = *loaded.check.tree;
+  auto start = MotionState(*scene, tree, plan, 0.0);
+  auto mid = MotionState(*scene, tree, plan, 1.0);
+  auto end = MotionState(*scene, tree, plan, 2.0);
+  ASSERT_TRUE(start && mid && end);
+  EXPECT_NEAR(start->q[0][0], home[0], 1e-12);
+  EXPECT_NEAR(mid->q[0][0], home[0] + 0.25, 1e-12);
+  EXPECT_NEAR(end->q[0][0], turned[0], 1e-12);
+  // Before the pick the seat rests where it started; at the pick it sits at the grasp.
+  EXPECT_TRUE(mid->X_WP[0].isApprox(start->X_WP[0], 1e-12));
+  const SceneRobot& r0 = scene->robots[0];
+  const Iso3 X_WT = TcpPose(r0.chain, r0.X_WB, turned, r0.end_effector.X_FT);
+  const PlanGrasp& g = plan.actions[0].grasps[0].grasp;
+  const Iso3 expected = X_WT * (scene->parts[0].X_AP * g.X_PG).inverse() * scene->parts[0].X_AP;
+  EXPECT_TRUE(end->X_WP[0].isApprox(expected, 1e-9));
+  EXPECT_NEAR(end->opening_m[0], 0.022, 1e-12);
+
+  const fs::path file = OutDir("motion_input") / "motion.json";
+  ASSERT_TRUE(SavePlan(plan, file).has_value());
+  const fs::path frames = OutDir("motion_frames");
+  ProcessRun r = RunWrap({"render", Project("stool"), "--plan", file.string(), "-o",
+                          frames.string(), "--size", "160x120", "--frames", "3"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto first = ReadPng(frames / "frame_000.png");
+  auto last = ReadPng(frames / "frame_002.png");
+  ASSERT_TRUE(first.has_value() && last.has_value());
+  EXPECT_LT(CompareImages(*first, *last, kTolerance).fraction_within, 1.0);
 }
 
 TEST(RenderCli, PlanKeyframesAreDrawn) {

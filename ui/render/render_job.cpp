@@ -7,8 +7,10 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <map>
 
 #include "render/contact_sheet.h"
+#include "robot/kinematics.h"
 #include "render/renderer.h"
 #include "render/video.h"
 #include "sim/mujoco_model.h"
@@ -337,8 +339,131 @@ Result<std::vector<SceneState>> PlanStates(const CellScene& scene, const Assembl
   return states;
 }
 
+Result<SceneState> MotionState(const CellScene& scene, const AssemblyTree& tree, const Plan& plan,
+                               double t) {
+  const size_t n_robots = scene.robots.size();
+  if (plan.trajectories.size() != n_robots) {
+    return Fail(ErrorCode::kInvalidInput, "plan: it has no trajectories for the cell's " +
+                                              std::to_string(n_robots) + " robots");
+  }
+  SceneState state;
+  std::vector<Iso3> X_WT(n_robots);
+  for (size_t r = 0; r < n_robots; ++r) {
+    const SceneRobot& robot = scene.robots[r];
+    const RobotTrajectory& tr = plan.trajectories[r];
+    if (tr.knots.empty() || tr.knots.front().q.size() != robot.chain.dof()) {
+      return Fail(ErrorCode::kInvalidInput,
+                  "plan: the trajectory of robot '" + robot.name + "' does not fit its joints");
+    }
+    state.q.push_back(SampleTrajectory(tr, t));
+    const double o = OpeningAt(tr, t);
+    const double stroke = robot.end_effector.stroke_m;
+    state.opening_m.push_back(o < 0.0 ? stroke : std::clamp(o, 0.0, stroke));
+    X_WT[r] = TcpPose(robot.chain, robot.X_WB, state.q.back(), robot.end_effector.X_FT);
+  }
+  // Objects: replay the actions whose moments have passed (in time order).
+  struct Object {
+    Iso3 X_WA;
+    std::vector<int> holders;  // in robot order; the first carries it
+  };
+  std::map<int, Object> objects;
+  std::vector<PlanGrasp> grasp(n_robots);
+  for (const PlanObject& o : plan.initial.objects) objects[o.node] = {o.X_WA, {}};
+  std::vector<int> order(plan.actions.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return plan.actions[a].end_s < plan.actions[b].end_s;
+  });
+  auto pose_now = [&](const Object& o) {
+    if (o.holders.empty()) return o.X_WA;
+    const PlanGrasp& g = grasp[o.holders.front()];
+    return X_WT[o.holders.front()] * (scene.parts[g.part].X_AP * g.X_PG).inverse();
+  };
+  for (int i : order) {
+    const PlanAction& a = plan.actions[i];
+    if (a.end_s > t) break;
+    const int node = a.objects.empty() ? -1 : a.objects[0];
+    auto keyframe_pose = [&](int n) {
+      for (const PlanObject& o : a.keyframe.objects) {
+        if (o.node == n) return o.X_WA;
+      }
+      return objects[n].X_WA;
+    };
+    auto drop = [&](int r) {
+      auto& h = objects[node].holders;
+      h.erase(std::remove(h.begin(), h.end(), r), h.end());
+    };
+    auto take = [&](int r, const PlanGrasp& g) {
+      auto& h = objects[node].holders;
+      h.push_back(r);
+      std::sort(h.begin(), h.end());
+      grasp[r] = g;
+    };
+    switch (a.type) {
+      case ActionType::kPick:
+      case ActionType::kAddGrasp:
+        take(a.robots[0], a.grasps[0].grasp);
+        break;
+      case ActionType::kPlace:
+      case ActionType::kRelease:
+        objects[node].X_WA = keyframe_pose(node);
+        drop(a.robots[0]);
+        break;
+      case ActionType::kHandover:
+        drop(a.robots[0]);
+        take(a.robots[1], a.grasps[1].grasp);
+        break;
+      case ActionType::kAssemble: {
+        Object merged{keyframe_pose(a.objects[1]), {}};
+        for (int n : {a.objects[0], a.objects[1]}) {
+          for (int r : objects[n].holders) merged.holders.push_back(r);
+          objects.erase(n);
+        }
+        std::sort(merged.holders.begin(), merged.holders.end());
+        objects[a.objects[2]] = merged;
+        break;
+      }
+    }
+  }
+  state.X_WP.assign(scene.parts.size(), Iso3::Identity());
+  for (const auto& [n, o] : objects) {
+    if (n < 0 || n >= static_cast<int>(tree.nodes.size())) {
+      return Fail(ErrorCode::kInvalidInput, "plan: object node " + std::to_string(n) +
+                                                " is not in the assembly");
+    }
+    const Iso3 X_WA = pose_now(o);
+    for (int p : tree.nodes[n].parts) state.X_WP[p] = X_WA * scene.parts[p].X_AP;
+  }
+  return state;
+}
+
 Result<std::vector<Shot>> PlanShots(const CellScene& scene, const AssemblyTree& tree,
                                     const Plan& plan, const PlanShotOptions& options) {
+  if (!plan.trajectories.empty() && options.at.empty() && options.frames > 0) {
+    // With motion: frames evenly in time.
+    auto times = FrameTimes(plan.stats.makespan_s, options.frames, {});
+    if (!times) return std::unexpected(times.error());
+    std::vector<Shot> shots;
+    for (size_t f = 0; f < times->size(); ++f) {
+      const double t = (*times)[f];
+      auto state = MotionState(scene, tree, plan, t);
+      if (!state) return std::unexpected(state.error());
+      // Caption: the action under way (the first whose moment is still ahead).
+      std::string doing = "done";
+      for (const PlanAction& a : plan.actions) {
+        if (a.end_s >= t) {
+          doing = DescribeAction(plan, a);
+          break;
+        }
+      }
+      char head[48];
+      std::snprintf(head, sizeof head, "t = %.1f s: ", t);
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%03zu.png", f);
+      shots.push_back({std::move(*state), head + doing, name});
+    }
+    return shots;
+  }
   auto states = PlanStates(scene, tree, plan);
   if (!states) return std::unexpected(states.error());
   const std::vector<PlanTimelineEntry> timeline = PlanTimeline(plan);

@@ -121,10 +121,18 @@ std::vector<PlanTimelineEntry> PlanTimeline(const Plan& plan);
 Result<std::vector<SceneState>> PlanStates(const CellScene& scene, const AssemblyTree& tree,
                                            const Plan& plan);
 
+/// The scene at time t [s] of a plan with motion (trajectories): robots from their timed
+/// trajectories with their fingers' openings, resting objects where their last keyframe left them,
+/// held objects with their first holder's TCP (the actions take effect at their end_s). Fails with
+/// kInvalidInput when the plan has no trajectories or they do not fit the cell.
+Result<SceneState> MotionState(const CellScene& scene, const AssemblyTree& tree, const Plan& plan,
+                               double t);
+
 /// Options of PlanShots.
 struct PlanShotOptions {
-  /// >= 1: this many frames evenly along the timeline, frame k of N showing keyframe
-  /// round(k (K - 1) / (N - 1)) of K; negative: every keyframe once; 0 is refused.
+  /// >= 1: this many frames evenly along the timeline: with motion, evenly in time from 0 to the
+  /// makespan (MotionState); without, frame k of N showing keyframe round(k (K - 1) / (N - 1)) of
+  /// K; negative: every keyframe once; 0 is refused.
   int frames = -1;
   /// Keyframe indices to draw, in this order (whole numbers in [0, K - 1]); when given they
   /// replace `frames`.
