@@ -5,17 +5,17 @@
 #include "core/run_context.h"
 #include "grasp/preprocess.h"
 #include "load.h"
-#include "task/plan_json.h"
-#include "task/plan_validator.h"
 #include "motion/trajectory_check.h"
 #include "pipeline/pipeline.h"
+#include "task/plan_json.h"
+#include "task/plan_validator.h"
 #include "task/planner.h"
 #include "task/world.h"
 
 namespace wrap::cli {
 
-int ReportPlanValidation(const LoadedProject& loaded, const Plan& plan,
-                         const std::string& project, std::ostream& out, std::ostream& err) {
+int ReportPlanValidation(const LoadedProject& loaded, const Plan& plan, const std::string& project,
+                         std::ostream& out, std::ostream& err) {
   PlanValidationOptions vopt;
   if (plan.stats.wrench_mode == "gravity") {
     vopt.wrench_mode = MatingWrenchMode::kGravityOnly;
@@ -104,8 +104,7 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   if (st.solved) {
     if (args.optimize) {
       out << "Improved: cost " << st.first_cost << " -> " << st.cost << " in "
-          << Fmt("%.2f", st.t_opt_s) << " s (" << st.cost_history.size() - 1
-          << " improvements)\n";
+          << Fmt("%.2f", st.t_opt_s) << " s (" << st.cost_history.size() - 1 << " improvements)\n";
     }
     out << "Solved: cost " << st.cost << ", time to first plan " << Fmt("%.2f", st.t_init_s)
         << " s (t_fwd " << Fmt("%.2f", st.t_fwd_s) << ", t_ik " << Fmt("%.2f", st.t_ik_s)
@@ -120,8 +119,7 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
           << " segments; t_kf " << Fmt("%.2f", st.t_kf_s) << " s, t_mp " << Fmt("%.2f", st.t_mp_s)
           << " s, t_retime " << Fmt("%.2f", st.t_retime_s) << " s";
       if (st.motion_suspensions > 0 || st.task_plans > 1) {
-        out << " (" << st.motion_suspensions << " suspensions, " << st.task_plans
-            << " task plans)";
+        out << " (" << st.motion_suspensions << " suspensions, " << st.task_plans << " task plans)";
       }
       out << "\n";
     }
@@ -137,8 +135,34 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
     out << "Wrote " << args.output << "\n";
   }
   if (!st.solved) return 1;
-
-  if (args.validate) return ReportPlanValidation(loaded, *plan, args.project, out, err);
+  if (!args.validate) return 0;
+  if (const int code = ReportPlanValidation(loaded, *plan, args.project, out, err); code != 0) {
+    return code;
+  }
+  if (!st.motion) return 0;
+  auto world = BuildTaskWorld(p, loaded.check, *pre, args.project);
+  if (!world) {
+    err << args.project << ": " << world.error().message << "\n";
+    return ExitCodeFor(world.error().code);
+  }
+  TrajectoryCheckOptions topt;
+  auto check = CheckTrajectories(*world, *plan, topt);
+  if (!check) {
+    err << "trajectory check: " << check.error().message << "\n";
+    return ExitCodeFor(check.error().code);
+  }
+  if (!check->valid) {
+    err << "Trajectory check FAILED: " << check->issues.size() << " issue(s)\n";
+    for (const TrajectoryIssue& issue : check->issues) {
+      err << "  " << FormatTrajectoryIssue(*plan, issue) << "\n";
+    }
+    return 1;
+  }
+  out << "Trajectories checked: " << check->samples << " moments at "
+      << Fmt("%g", topt.resolution_rad) << " rad joint resolution, limits (peak "
+      << Fmt("%.0f", 100 * check->max_velocity_ratio) << "% of velocity, "
+      << Fmt("%.0f", 100 * check->max_acceleration_ratio)
+      << "% of acceleration), events and grasps: no issue\n";
   return 0;
 }
 

@@ -18,8 +18,7 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
   MotionAttempt out;
   auto t0 = std::chrono::steady_clock::now();
   Plan work = plan;  // keyframes may be rebranched: only a plan with motion keeps them
-  auto segments =
-      PlanGeometricMotion(world, work, options, effort, seed, cache, ctx, &out.failure);
+  auto segments = PlanGeometricMotion(world, work, options, effort, seed, cache, ctx, &out.failure);
   out.t_mp_s = Since(t0);
   ctx.AddTime("mp", out.t_mp_s);
   if (!segments) return std::unexpected(segments.error());

@@ -17,7 +17,7 @@ namespace wrap {
 struct MotionAttempt {
   bool solved = false;    ///< Trajectories were made (plan updated).
   MotionFailure failure;  ///< Otherwise which segment failed and whether to retry with more effort.
-  double t_mp_s = 0.0;      ///< Geometric motion [s].
+  double t_mp_s = 0.0;    ///< Geometric motion [s].
   double t_retime_s = 0.0;  ///< Retiming [s].
 };
 

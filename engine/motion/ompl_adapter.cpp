@@ -56,8 +56,8 @@ class DenseMotionValidator : public ob::MotionValidator {
                    std::pair<ob::State*, double>& last_valid) const override {
     const Eigen::VectorXd a = ToVector(s1, dim_);
     const Eigen::VectorXd b = ToVector(s2, dim_);
-    const int steps = std::max(1, static_cast<int>(std::ceil(
-                                      (b - a).cwiseAbs().maxCoeff() / query_.resolution)));
+    const int steps =
+        std::max(1, static_cast<int>(std::ceil((b - a).cwiseAbs().maxCoeff() / query_.resolution)));
     for (int k = 1; k <= steps; ++k) {
       const double t = static_cast<double>(k) / steps;
       ++*checks_;
@@ -100,7 +100,8 @@ std::vector<double> Cumulative(const std::vector<Eigen::VectorXd>& path) {
 }
 
 // Every piece valid at the query's resolution.
-bool PathValid(const PathQuery& query, const std::vector<Eigen::VectorXd>& path, long long* checks) {
+bool PathValid(const PathQuery& query, const std::vector<Eigen::VectorXd>& path,
+               long long* checks) {
   for (size_t i = 1; i < path.size(); ++i) {
     if (!StraightMotionValid(query, path[i - 1], path[i], checks)) return false;
   }
@@ -222,9 +223,8 @@ PathAnswer PlanPath(const PathQuery& query) {
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                             std::chrono::duration<double>(query.time_limit_s));
-  ob::PlannerTerminationCondition ptc([&] {
-    return std::chrono::steady_clock::now() >= deadline || (query.stop && query.stop());
-  });
+  ob::PlannerTerminationCondition ptc(
+      [&] { return std::chrono::steady_clock::now() >= deadline || (query.stop && query.stop()); });
   std::uint64_t attempt_seed = seed;
   while (true) {
     const ob::PlannerStatus status = planner->solve(ptc);

@@ -1,9 +1,9 @@
 #include "motion/retime.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cmath>
 #include <limits>
 #include <map>
 #include <string>
@@ -14,10 +14,10 @@ namespace {
 
 // A time-optimal rest-to-rest trapezoid in the path parameter s in [0, 1] of one straight piece.
 struct Profile {
-  double t_acc = 0.0;   // acceleration phase [s]
-  double t_total = 0.0; // whole piece [s]
-  double s_acc = 0.0;   // s reached at the end of the acceleration phase
-  double v_peak = 0.0;  // peak ds/dt [1/s]
+  double t_acc = 0.0;    // acceleration phase [s]
+  double t_total = 0.0;  // whole piece [s]
+  double s_acc = 0.0;    // s reached at the end of the acceleration phase
+  double v_peak = 0.0;   // peak ds/dt [1/s]
 };
 
 Profile Trapezoid(double vs, double as) {
@@ -184,7 +184,10 @@ Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
     if (std::getenv("WRAP_MOTION_DEBUG")) {
       std::fprintf(stderr, "[sched] %d %s a%d waits for %d (%s)\n", j,
                    std::string(ToString(s.kind)).c_str(), s.action + 1, binding,
-                   binding < 0 ? "-" : (dep[binding] == 1 ? "robot" : dep[binding] == 2 ? "object" : "sweep"));
+                   binding < 0 ? "-"
+                               : (dep[binding] == 1   ? "robot"
+                                  : dep[binding] == 2 ? "object"
+                                                      : "sweep"));
     }
     start[j] = t;
     end[j] = t + timed[j].duration;

@@ -158,9 +158,8 @@ Result<void> MotionScene::Set(const PlanState& state, std::span<const double> op
     const int node = object_of_part_[p];
     cell.SetObjectEnabled(p, node >= 0);
     for (int s = p + 1; s < w.num_parts; ++s) {
-      cell.SetObjectPairAllowed(p, s,
-                                node >= 0 && object_of_part_[s] >= 0 &&
-                                    allowed_nodes(node, object_of_part_[s]));
+      cell.SetObjectPairAllowed(
+          p, s, node >= 0 && object_of_part_[s] >= 0 && allowed_nodes(node, object_of_part_[s]));
     }
     bool table = false;
     if (node >= 0) {

@@ -1,11 +1,11 @@
 #include "motion/segments.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <array>
-#include <cmath>
 #include <functional>
 #include <random>
 #include <set>
@@ -19,8 +19,8 @@ namespace wrap {
 
 namespace {
 
-constexpr std::array<std::string_view, 8> kKindNames = {
-    "free", "approach", "retreat", "lift", "descend", "insert", "carry", "grip"};
+constexpr std::array<std::string_view, 8> kKindNames = {"free",    "approach", "retreat", "lift",
+                                                        "descend", "insert",   "carry",   "grip"};
 
 // Largest joint jump between two IK samples of a straight move before it counts as a branch
 // switch (no straight move there) [rad].
@@ -31,7 +31,7 @@ constexpr double kMaxSnap = 0.05;
 // Skills and the final free paths are checked this many times finer than the resolution, so
 // that the dense check of the timed motion, sampling other points of the same straight pieces
 // at the resolution, meets no grazing contact that the planner's samples stepped over.
-constexpr int kRefine = 8;
+constexpr int kRefine = 4;
 // Least distance between two robots at a keyframe, as the task planner keeps it [m].
 constexpr double kMinClearance = 0.005;
 
@@ -99,7 +99,7 @@ class Builder {
   std::string Name(int robot) const { return "'" + w_.robots[robot].name + "'"; }
   std::string NodeName(int node) const {
     return node >= 0 && node < static_cast<int>(plan_.nodes.size()) ? "'" + plan_.nodes[node] + "'"
-                                                                     : "object";
+                                                                    : "object";
   }
   // Adds the segment with the robots' current openings, advancing cur_ to its last waypoint.
   void Push(GeoSegment seg);
@@ -122,8 +122,7 @@ class Builder {
                        const std::vector<std::pair<int, int>>& mating);
   // Moves robot r from `old_q` to `new_q` at action `action`'s approach keyframe (when
   // `from_approach`) or keyframe and at every following keyframe where it kept `old_q`.
-  void Rebranch(int robot, int action, bool from_approach, const JointVector& old_q,
-                const JointVector& new_q);
+  void Rebranch(int robot, int action, bool from_approach, JointVector old_q, JointVector new_q);
 
   const TaskWorld& w_;
   Plan& plan_;
@@ -350,7 +349,8 @@ bool Builder::PathClear(const std::vector<int>& robots,
 std::vector<JointVector> Builder::BackOff(int robot, const JointVector& q, double* length) {
   const Iso3 X0 = Tcp(robot, q);
   const Vec3 axis = X0.linear().col(2);
-  for (double d : {opt_.approach_m, opt_.approach_m / 2, opt_.approach_m / 4, opt_.approach_m / 8}) {
+  for (double d :
+       {opt_.approach_m, opt_.approach_m / 2, opt_.approach_m / 4, opt_.approach_m / 8}) {
     const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
     auto target = [X0, axis, d](double s) {
       Iso3 X = X0;
@@ -482,12 +482,11 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
     const PathAnswer answer = PlanPath(query);
     for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], cur_[who[i]]);
     if (std::getenv("WRAP_MOTION_DEBUG")) {
-      std::fprintf(stderr, "[free] action %d robots %zu: %s, %lld checks, %.2f s, %zu waypoints\n",
-                   action + 1, who.size(), answer.solved ? "solved" : answer.why.c_str(),
-                   answer.checks,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t_query)
-                       .count(),
-                   answer.path.size());
+      std::fprintf(
+          stderr, "[free] action %d robots %zu: %s, %lld checks, %.2f s, %zu waypoints\n",
+          action + 1, who.size(), answer.solved ? "solved" : answer.why.c_str(), answer.checks,
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t_query).count(),
+          answer.path.size());
     }
     if (answer.solved) {
       for (const Eigen::VectorXd& x : answer.path) path->push_back(split(x));
@@ -708,8 +707,9 @@ bool Builder::KeyframeAccepts(int robot, const JointVector& q, const Keyframe& k
   return scene_.cell().MinRobotClearance(request).distance >= kMinClearance;
 }
 
-void Builder::Rebranch(int robot, int action, bool from_approach, const JointVector& old_q,
-                       const JointVector& new_q) {
+void Builder::Rebranch(int robot, int action, bool from_approach, JointVector old_q,
+                       JointVector new_q) {
+  // By value: old_q may be a keyframe's own joints, which this overwrites.
   for (size_t j = static_cast<size_t>(action); j < plan_.actions.size(); ++j) {
     PlanAction& b = plan_.actions[j];
     if (b.approach && (from_approach || j > static_cast<size_t>(action))) {
@@ -998,12 +998,18 @@ bool Builder::Action(int i) {
     seg.skill_speed_mps = opt_.skill_speed_mps;
     Push(std::move(seg));
   }
-  // Every robot is now at the keyframe.
+  // Every robot is now at the keyframe (a robot whose keyframe joints differ from where it is by
+  // whole turns only is where the keyframe wants it: the keyframes follow it).
   for (int r = 0; r < n_robots; ++r) {
+    if ((cur_[r] - K.q[r]).cwiseAbs().maxCoeff() > 1e-6 &&
+        (NearestEquivalent(w_.robots[r].chain, K.q[r], cur_[r]) - cur_[r]).cwiseAbs().maxCoeff() <=
+            1e-6) {
+      Rebranch(r, i, a.approach.has_value(), K.q[r], cur_[r]);
+    }
     if ((cur_[r] - K.q[r]).cwiseAbs().maxCoeff() > 1e-6) {
       return Fail(i, SegmentKind::kFree, false,
-                  "internal: " + Name(r) + " is not at the keyframe of action " +
-                      std::to_string(i + 1) + " after its motion");
+                  Name(r) + " would have to change its joints at the keyframe of action " +
+                      std::to_string(i + 1) + " while it holds an object that stays put");
     }
     cur_[r] = K.q[r];
   }

@@ -183,8 +183,9 @@ void Checker::CheckKnots(int r) {
         if (tau > 0.0 && tau < dt) {
           const double q = k[i - 1].q[j] + k[i - 1].qd[j] * tau + 0.5 * acc * tau * tau;
           if (q < J.lower - 1e-9 || q > J.upper + 1e-9) {
-            Issue(k[i - 1].t + tau, r, "limits",
-                  "joint " + std::to_string(j + 1) + " turns at " + Num(q) + ", outside its limits");
+            Issue(
+                k[i - 1].t + tau, r, "limits",
+                "joint " + std::to_string(j + 1) + " turns at " + Num(q) + ", outside its limits");
           }
         }
       }
@@ -204,7 +205,8 @@ void Checker::CheckEvents() {
   std::map<int, std::pair<double, int>> last_robot, last_object;  // -> (time, action)
   for (size_t i = 0; i < plan_.actions.size(); ++i) {
     const PlanAction& a = plan_.actions[i];
-    const std::string label = "action " + std::to_string(i + 1) + " (" + DescribeAction(plan_, a) + ")";
+    const std::string label =
+        "action " + std::to_string(i + 1) + " (" + DescribeAction(plan_, a) + ")";
     if (!(a.start_s >= 0.0) || !(a.end_s >= a.start_s)) {
       Issue(a.end_s, -1, "event", label + " has no times (start_s, end_s)");
       continue;
@@ -274,8 +276,8 @@ void Checker::CheckDense() {
       times.push_back(tr.knots[i].t);
       if (i == 0) continue;
       const double dt = tr.knots[i].t - tr.knots[i - 1].t;
-      const double v = std::max(tr.knots[i].qd.cwiseAbs().maxCoeff(),
-                                tr.knots[i - 1].qd.cwiseAbs().maxCoeff());
+      const double v =
+          std::max(tr.knots[i].qd.cwiseAbs().maxCoeff(), tr.knots[i - 1].qd.cwiseAbs().maxCoeff());
       const int n = static_cast<int>(std::ceil(v * dt / opt_.resolution_rad));
       for (int s = 1; s < n; ++s) times.push_back(tr.knots[i - 1].t + dt * s / n);
     }
@@ -288,9 +290,8 @@ void Checker::CheckDense() {
   // Events in time order.
   std::vector<int> events(plan_.actions.size());
   for (size_t i = 0; i < events.size(); ++i) events[i] = static_cast<int>(i);
-  std::stable_sort(events.begin(), events.end(), [&](int x, int y) {
-    return plan_.actions[x].end_s < plan_.actions[y].end_s;
-  });
+  std::stable_sort(events.begin(), events.end(),
+                   [&](int x, int y) { return plan_.actions[x].end_s < plan_.actions[y].end_s; });
   // Contact windows declared by the plan's skills.
   struct Window {
     double t0, t1;
@@ -374,8 +375,8 @@ void Checker::CheckDense() {
       const int node = node_of[p];
       cell->SetObjectEnabled(p, node >= 0);
       for (int o = p + 1; o < n_parts; ++o) {
-        const bool ok = node >= 0 && node_of[o] >= 0 &&
-                        (node == node_of[o] || window(-1, node, node_of[o]));
+        const bool ok =
+            node >= 0 && node_of[o] >= 0 && (node == node_of[o] || window(-1, node, node_of[o]));
         cell->SetObjectPairAllowed(p, o, ok);
       }
       bool table = false;

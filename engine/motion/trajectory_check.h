@@ -32,8 +32,8 @@ struct TrajectoryCheckOptions {
 
 /// One thing wrong with the trajectories.
 struct TrajectoryIssue {
-  double t = 0.0;     ///< When [s] (-1: not tied to a moment).
-  int robot = -1;     ///< Robot concerned, or -1.
+  double t = 0.0;  ///< When [s] (-1: not tied to a moment).
+  int robot = -1;  ///< Robot concerned, or -1.
   /// "format" (knots), "limits" (position, velocity, acceleration), "continuity" (knots that do
   /// not join), "start", "end", "event" (a robot away from its keyframe at its action's moment,
   /// events out of order), "grasp" (a co-holder away from its grasp), "collision".

@@ -112,8 +112,8 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
       return plan;
     }
     const MotionFailure& f = attempt->failure;
-    last_failure = "action " + std::to_string(f.action + 1) + ", " + f.segment + " segment: " +
-                   f.message;
+    last_failure =
+        "action " + std::to_string(f.action + 1) + ", " + f.segment + " segment: " + f.message;
     if (std::getenv("WRAP_MOTION_DEBUG")) {
       std::fprintf(stderr, "[motion] plan %d effort %d: %s%s\n", c.order, c.effort,
                    last_failure.c_str(), f.suspend ? " (suspended)" : "");
@@ -135,8 +135,8 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
   plan.stats.task_plans = made;
   plan.stats.failure = "no motion for the task plan" + std::string(made > 1 ? "s" : "") +
                        " found (" + std::to_string(made) + " tried" +
-                       (ctx.timed_out() ? ", time limit reached" : "") + "); last: " +
-                       (last_failure.empty() ? "none planned" : last_failure);
+                       (ctx.timed_out() ? ", time limit reached" : "") +
+                       "); last: " + (last_failure.empty() ? "none planned" : last_failure);
   return plan;
 }
 

@@ -21,10 +21,10 @@ namespace wrap {
 
 /// Options of PlanAssembly.
 struct PipelineOptions {
-  TaskPlannerOptions task;       ///< The task planner's.
-  MotionOptions motion;          ///< The motion planner's.
-  KeyframeOptOptions keyframes;  ///< Joint keyframe optimisation's.
-  bool task_only = false;        ///< Stop after the task plan (no keyframe optimisation, motion).
+  TaskPlannerOptions task;         ///< The task planner's.
+  MotionOptions motion;            ///< The motion planner's.
+  KeyframeOptOptions keyframes;    ///< Joint keyframe optimisation's.
+  bool task_only = false;          ///< Stop after the task plan (no keyframe optimisation, motion).
   bool optimize_keyframes = true;  ///< Run the joint keyframe optimisation before motion.
   int max_task_plans = 8;  ///< Task plans the loop may ask for (the first with ctx's generator).
   /// The run's seed (ctx's): recorded in the stats; further task plans and the motion planner's
@@ -37,7 +37,6 @@ struct PipelineOptions {
 /// not be planned and why (the plan keeps its keyframes). Stage times: the task planner's, "kf",
 /// "mp", "retime". Fails like PlanTask (kInvalidInput, kCancelled).
 Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
-                          const Preprocessed& pre, const PipelineOptions& options,
-                          RunContext& ctx);
+                          const Preprocessed& pre, const PipelineOptions& options, RunContext& ctx);
 
 }  // namespace wrap

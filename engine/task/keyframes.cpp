@@ -832,7 +832,8 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
             return x.node == m.node && s.held[x.robot] == x.node;
           }) >= 2) {
         const int branch = UrBranch(m.robot, c.q[m.robot]);
-        std::erase_if(sols[i], [&](const JointVector& q) { return UrBranch(m.robot, q) != branch; });
+        std::erase_if(sols[i],
+                      [&](const JointVector& q) { return UrBranch(m.robot, q) != branch; });
         if (sols[i].empty()) {
           note(Gate::kIk, "'" + world_.robots[m.robot].name +
                               "' cannot carry its object there with the others on its IK branch");

@@ -111,7 +111,6 @@ std::string DescribeAction(const Plan& plan, const PlanAction& action) {
   return "unknown action";
 }
 
-
 namespace {
 // Index of the last knot at or before t (0 when t is before the first).
 size_t KnotBefore(const RobotTrajectory& trajectory, double t) {

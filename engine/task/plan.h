@@ -144,64 +144,64 @@ struct MotionSegment {
   std::vector<int> robots;  ///< Robots that take part.
   /// Objects (node ids) it moves or touches: carried, approached, released, inserted.
   std::vector<int> objects;
-  double start_s = 0.0;     ///< Start [s].
-  double end_s = 0.0;       ///< End [s].
+  double start_s = 0.0;  ///< Start [s].
+  double end_s = 0.0;    ///< End [s].
 };
 
 /// Statistics of a planner run (the paper's breakdown table and search counters).
 struct PlanStats {
-  bool solved = false;          ///< A plan was found.
-  int cost = 0;                 ///< Number of actions (the paper's cost).
-  double t_init_s = 0.0;        ///< Time to the first task plan, without preprocessing [s].
-  double t_grasp_s = 0.0;       ///< Preprocessing (grasps, placements, table slots) [s].
-  double t_bwd_s = 0.0;         ///< Backward (heuristic) search [s].
-  double t_lp_s = 0.0;          ///< Wrench LPs [s].
-  double t_fwd_s = 0.0;         ///< Forward search, without IK and LP [s].
-  double t_ik_s = 0.0;          ///< IK, collision and clearance checks of keyframes [s].
-  std::string planner;          ///< Planner variant, e.g. "counting".
-  std::uint64_t seed = 0;       ///< Seed of the run.
-  std::string wrench_mode;      ///< "full", "gravity" or "none".
-  double force_scale = 1.0;     ///< Lambda on the mating wrench.
-  int grasps = 0;               ///< Grasp-set size of the preprocessing.
-  long long expansions = 0;     ///< Search nodes expanded.
-  long long validations = 0;    ///< Edges validated (IK, collision, wrench).
+  bool solved = false;                ///< A plan was found.
+  int cost = 0;                       ///< Number of actions (the paper's cost).
+  double t_init_s = 0.0;              ///< Time to the first task plan, without preprocessing [s].
+  double t_grasp_s = 0.0;             ///< Preprocessing (grasps, placements, table slots) [s].
+  double t_bwd_s = 0.0;               ///< Backward (heuristic) search [s].
+  double t_lp_s = 0.0;                ///< Wrench LPs [s].
+  double t_fwd_s = 0.0;               ///< Forward search, without IK and LP [s].
+  double t_ik_s = 0.0;                ///< IK, collision and clearance checks of keyframes [s].
+  std::string planner;                ///< Planner variant, e.g. "counting".
+  std::uint64_t seed = 0;             ///< Seed of the run.
+  std::string wrench_mode;            ///< "full", "gravity" or "none".
+  double force_scale = 1.0;           ///< Lambda on the mating wrench.
+  int grasps = 0;                     ///< Grasp-set size of the preprocessing.
+  long long expansions = 0;           ///< Search nodes expanded.
+  long long validations = 0;          ///< Edges validated (IK, collision, wrench).
   long long validation_failures = 0;  ///< ... that failed.
-  long long lp_checks = 0;      ///< Wrench checks asked (cache hits included).
-  long long lp_cache_hits = 0;  ///< ... answered from the cache.
-  long long ik_calls = 0;       ///< IK queries.
-  long long collision_checks = 0;  ///< Cell collision queries.
-  int milestones = 0;           ///< Milestones (assembly steps) planned.
-  int backtracks = 0;           ///< Milestones re-planned after a later one failed.
-  int widenings = 0;            ///< Grasp and placement subsets widened.
-  bool out_of_memory = false;   ///< Stopped at the memory limit (failure says so).
-  int first_cost = 0;           ///< Cost of the first plan (before --optimize).
-  double t_opt_s = 0.0;         ///< Plan improvement (--optimize) [s].
+  long long lp_checks = 0;            ///< Wrench checks asked (cache hits included).
+  long long lp_cache_hits = 0;        ///< ... answered from the cache.
+  long long ik_calls = 0;             ///< IK queries.
+  long long collision_checks = 0;     ///< Cell collision queries.
+  int milestones = 0;                 ///< Milestones (assembly steps) planned.
+  int backtracks = 0;                 ///< Milestones re-planned after a later one failed.
+  int widenings = 0;                  ///< Grasp and placement subsets widened.
+  bool out_of_memory = false;         ///< Stopped at the memory limit (failure says so).
+  int first_cost = 0;                 ///< Cost of the first plan (before --optimize).
+  double t_opt_s = 0.0;               ///< Plan improvement (--optimize) [s].
   /// Cost over time (--optimize): (seconds since planning started, cost) at the first plan
   /// and at every improvement.
   std::vector<std::pair<double, int>> cost_history;
-  std::string failure;          ///< Empty when solved, else why not, in words.
+  std::string failure;  ///< Empty when solved, else why not, in words.
   // Motion (paper §IV-D keyframe optimisation, §IV-E motion planning, §IV-F retiming).
-  bool motion = false;               ///< Trajectories were planned (false: task plan only).
-  double t_kf_s = 0.0;               ///< Joint keyframe optimisation [s].
-  double t_mp_s = 0.0;               ///< Motion planning of the plan that succeeded [s].
-  double t_retime_s = 0.0;           ///< Retiming and scheduling [s].
-  double makespan_s = 0.0;           ///< Execution time with robots moving concurrently [s].
+  bool motion = false;                 ///< Trajectories were planned (false: task plan only).
+  double t_kf_s = 0.0;                 ///< Joint keyframe optimisation [s].
+  double t_mp_s = 0.0;                 ///< Motion planning of the plan that succeeded [s].
+  double t_retime_s = 0.0;             ///< Retiming and scheduling [s].
+  double makespan_s = 0.0;             ///< Execution time with robots moving concurrently [s].
   double makespan_sequential_s = 0.0;  ///< Same plan, one motion segment at a time [s].
-  int motion_segments = 0;           ///< Segments (free paths and skills).
-  int motion_suspensions = 0;        ///< Segments that timed out and were suspended.
-  int task_plans = 0;                ///< Task plans tried by the motion loop.
+  int motion_segments = 0;             ///< Segments (free paths and skills).
+  int motion_suspensions = 0;          ///< Segments that timed out and were suspended.
+  int task_plans = 0;                  ///< Task plans tried by the motion loop.
 };
 
 /// A plan of a project.
 struct Plan {
-  std::string project;                  ///< Project name.
-  std::vector<std::string> robots;      ///< Robot names, Project::robots order.
-  std::vector<std::string> parts;       ///< Part names, Project::parts order.
-  std::vector<std::string> nodes;       ///< DAG node names by node id (parts, then steps).
-  std::vector<int> milestone_steps;     ///< Step node id of each milestone, in planning order.
-  Keyframe initial;                     ///< Robots at home, parts at their initial poses.
-  std::vector<PlanAction> actions;      ///< The action sequence.
-  PlanStats stats;                      ///< How it was found.
+  std::string project;               ///< Project name.
+  std::vector<std::string> robots;   ///< Robot names, Project::robots order.
+  std::vector<std::string> parts;    ///< Part names, Project::parts order.
+  std::vector<std::string> nodes;    ///< DAG node names by node id (parts, then steps).
+  std::vector<int> milestone_steps;  ///< Step node id of each milestone, in planning order.
+  Keyframe initial;                  ///< Robots at home, parts at their initial poses.
+  std::vector<PlanAction> actions;   ///< The action sequence.
+  PlanStats stats;                   ///< How it was found.
   /// Timed trajectories, one per robot (Project::robots order); empty without motion.
   std::vector<RobotTrajectory> trajectories;
   std::vector<MotionSegment> segments;  ///< How the motion was made, by start time.
@@ -209,7 +209,8 @@ struct Plan {
 
 /// Joint positions (and velocities when `qd` is given) of a trajectory at time t, clamped to its
 /// first and last knot. The trajectory must have knots.
-JointVector SampleTrajectory(const RobotTrajectory& trajectory, double t, JointVector* qd = nullptr);
+JointVector SampleTrajectory(const RobotTrajectory& trajectory, double t,
+                             JointVector* qd = nullptr);
 /// Finger opening of a trajectory at time t (the opening of the last knot at or before t).
 double OpeningAt(const RobotTrajectory& trajectory, double t);
 

@@ -560,7 +560,8 @@ class PlanReader {
         Bad(path, "expected an array of " + std::to_string(dof) + " numbers (the robot's joints)");
       }
       JointVector v(static_cast<Eigen::Index>(dof));
-      for (size_t k = 0; k < dof; ++k) v[static_cast<Eigen::Index>(k)] = NumberValue(values[k], Index(path, k));
+      for (size_t k = 0; k < dof; ++k)
+        v[static_cast<Eigen::Index>(k)] = NumberValue(values[k], Index(path, k));
       return v;
     };
     for (size_t k = 0; k < t.size(); ++k) {
@@ -568,8 +569,8 @@ class PlanReader {
       knot.t = NumberValue(t[k], Index(Join(at, "t"), k));
       if (k == 0 && knot.t != 0.0) Bad(Index(Join(at, "t"), k), "the first knot must be at 0 s");
       if (k > 0 && !(knot.t >= tr.knots.back().t)) {
-        Bad(Index(Join(at, "t"), k), "times must not decrease (previous " +
-                                         std::to_string(tr.knots.back().t) + ")");
+        Bad(Index(Join(at, "t"), k),
+            "times must not decrease (previous " + std::to_string(tr.knots.back().t) + ")");
       }
       knot.q = vector(q[k], Index(Join(at, "q"), k));
       knot.qd = vector(qd[k], Index(Join(at, "qd"), k));
@@ -606,16 +607,44 @@ class PlanReader {
 
 PlanStats ReadStats(const json& root, const std::string& at) {
   const json& j = ExpectObject(Member(root, "", "stats"), at);
-  CheckKeys(j, at, {"solved",     "cost",          "t_init_s",    "planner",
-                    "seed",       "t_grasp_s",     "t_bwd_s",     "t_lp_s",
-                    "t_fwd_s",    "t_ik_s",        "wrench_mode", "force_scale",
-                    "grasps",     "expansions",    "validations", "validation_failures",
-                    "lp_checks",  "lp_cache_hits", "ik_calls",    "collision_checks",
-                    "milestones", "backtracks",    "widenings",   "out_of_memory",
-                    "first_cost", "t_opt_s",       "cost_history", "failure",
-                    "motion",     "t_kf_s",        "t_mp_s",      "t_retime_s",
-                    "makespan_s", "makespan_sequential_s",        "motion_segments",
-                    "motion_suspensions",          "task_plans"});
+  CheckKeys(j, at,
+            {"solved",
+             "cost",
+             "t_init_s",
+             "planner",
+             "seed",
+             "t_grasp_s",
+             "t_bwd_s",
+             "t_lp_s",
+             "t_fwd_s",
+             "t_ik_s",
+             "wrench_mode",
+             "force_scale",
+             "grasps",
+             "expansions",
+             "validations",
+             "validation_failures",
+             "lp_checks",
+             "lp_cache_hits",
+             "ik_calls",
+             "collision_checks",
+             "milestones",
+             "backtracks",
+             "widenings",
+             "out_of_memory",
+             "first_cost",
+             "t_opt_s",
+             "cost_history",
+             "failure",
+             "motion",
+             "t_kf_s",
+             "t_mp_s",
+             "t_retime_s",
+             "makespan_s",
+             "makespan_sequential_s",
+             "motion_segments",
+             "motion_suspensions",
+             "task_plans"});
   PlanStats s;
   // Required: what DESIGN.md promises every plan file holds.
   s.solved = Bool(j, at, "solved");
@@ -883,7 +912,8 @@ std::string SerializePlan(const Plan& plan) {
   doc["actions"] = actions;
   if (!plan.trajectories.empty()) {
     ojson trajectories = ojson::array();
-    for (const RobotTrajectory& tr : plan.trajectories) trajectories.push_back(TrajectoryJson(plan, tr));
+    for (const RobotTrajectory& tr : plan.trajectories)
+      trajectories.push_back(TrajectoryJson(plan, tr));
     doc["trajectories"] = trajectories;
     ojson segments = ojson::array();
     for (const MotionSegment& m : plan.segments) segments.push_back(SegmentJson(plan, m));

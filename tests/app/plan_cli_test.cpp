@@ -70,9 +70,9 @@ TEST(PlanCli, SeedAndWrenchModeReachTheStats) {
 TEST(PlanCli, OptimizeRecordsTheCostOverTime) {
   const fs::path dir = TempDir("optimize");
   const fs::path out = dir / "plan.json";
-  const CliRun r = Wrap({"plan", Project("half_stool"), "-o", out.string(), "--optimize",
-                         "--time-limit", "20", "--planner", "counting", "--validate",
-                         "--task-only"});
+  const CliRun r =
+      Wrap({"plan", Project("half_stool"), "-o", out.string(), "--optimize", "--time-limit", "20",
+            "--planner", "counting", "--validate", "--task-only"});
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("Improved: cost "), std::string::npos) << r.out;
   std::ifstream in(out);

@@ -19,9 +19,9 @@
 #include <sstream>
 
 #include "model/validate.h"
+#include "render/image.h"
 #include "render/render_job.h"
 #include "robot/kinematics.h"
-#include "render/image.h"
 #include "sim/scene.h"
 #include "task/plan_json.h"
 
@@ -325,7 +325,8 @@ TEST(RenderCli, MotionFramesFollowTheTrajectories) {
     if (r == 0) {
       // Constant acceleration between knots: 0 -> v at 1 s (mid-way), v -> 0 at 2 s.
       const JointVector v = turned - home;
-      tr.knots = {{0.0, home, zero, -1.0}, {1.0, JointVector(0.5 * (home + turned)), v, -1.0},
+      tr.knots = {{0.0, home, zero, -1.0},
+                  {1.0, JointVector(0.5 * (home + turned)), v, -1.0},
                   {2.0, turned, zero, 0.022}};
     } else {
       tr.knots = {{0.0, q0, zero, -1.0}, {2.0, q0, zero, -1.0}};
@@ -349,7 +350,7 @@ TEST(RenderCli, MotionFramesFollowTheTrajectories) {
   EXPECT_TRUE(end->X_WP[0].isApprox(expected, 1e-9));
   EXPECT_NEAR(end->opening_m[0], 0.022, 1e-12);
 
-  const fs::path file = OutDir("motion_input") / "motion.json";
+  const fs::path file = input.parent_path() / "motion.json";
   ASSERT_TRUE(SavePlan(plan, file).has_value());
   const fs::path frames = OutDir("motion_frames");
   ProcessRun r = RunWrap({"render", Project("stool"), "--plan", file.string(), "-o",

@@ -10,9 +10,9 @@
 #include <map>
 
 #include "render/contact_sheet.h"
-#include "robot/kinematics.h"
 #include "render/renderer.h"
 #include "render/video.h"
+#include "robot/kinematics.h"
 #include "sim/mujoco_model.h"
 
 namespace wrap::render {
@@ -371,9 +371,8 @@ Result<SceneState> MotionState(const CellScene& scene, const AssemblyTree& tree,
   for (const PlanObject& o : plan.initial.objects) objects[o.node] = {o.X_WA, {}};
   std::vector<int> order(plan.actions.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-    return plan.actions[a].end_s < plan.actions[b].end_s;
-  });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return plan.actions[a].end_s < plan.actions[b].end_s; });
   auto pose_now = [&](const Object& o) {
     if (o.holders.empty()) return o.X_WA;
     const PlanGrasp& g = grasp[o.holders.front()];
@@ -428,8 +427,8 @@ Result<SceneState> MotionState(const CellScene& scene, const AssemblyTree& tree,
   state.X_WP.assign(scene.parts.size(), Iso3::Identity());
   for (const auto& [n, o] : objects) {
     if (n < 0 || n >= static_cast<int>(tree.nodes.size())) {
-      return Fail(ErrorCode::kInvalidInput, "plan: object node " + std::to_string(n) +
-                                                " is not in the assembly");
+      return Fail(ErrorCode::kInvalidInput,
+                  "plan: object node " + std::to_string(n) + " is not in the assembly");
     }
     const Iso3 X_WA = pose_now(o);
     for (int p : tree.nodes[n].parts) state.X_WP[p] = X_WA * scene.parts[p].X_AP;
