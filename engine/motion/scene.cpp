@@ -113,11 +113,12 @@ Result<void> MotionScene::Set(const PlanState& state, std::span<const double> op
   auto it = cells_.find(key);
   if (it == cells_.end()) {
     CellDef def = w.cell_def;
+    // The task world's cell leaves the fingers out (the task planner moves them as bodies of
+    // their own): here they are part of the gripper, fully open or at the opening.
     for (int r = 0; r < n_robots; ++r) {
-      if (openings[r] >= 0.0) {
-        def.robots[r].end_effector.collision =
-            EndEffectorShapesAt(w.robots[r].end_effector, openings[r]);
-      }
+      const EndEffector& ee = w.robots[r].end_effector;
+      def.robots[r].end_effector.collision =
+          openings[r] >= 0.0 ? EndEffectorShapesAt(ee, openings[r]) : ee.collision;
     }
     CellOptions options;
     options.objects_touch_table = false;  // decided per state below

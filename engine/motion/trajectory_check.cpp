@@ -246,11 +246,11 @@ Cell* Checker::CellFor(const std::vector<double>& openings) {
   for (double o : openings) key.push_back(o < 0.0 ? -1 : std::llround(o * 1e5));
   if (auto it = cells_.find(key); it != cells_.end()) return &it->second;
   CellDef def = w_.cell_def;
+  // With the fingers (the task world's cell leaves them out): fully open, or at the opening.
   for (size_t r = 0; r < w_.robots.size(); ++r) {
-    if (openings[r] >= 0.0) {
-      def.robots[r].end_effector.collision =
-          EndEffectorShapesAt(w_.robots[r].end_effector, openings[r]);
-    }
+    const EndEffector& ee = w_.robots[r].end_effector;
+    def.robots[r].end_effector.collision =
+        openings[r] >= 0.0 ? EndEffectorShapesAt(ee, openings[r]) : ee.collision;
   }
   CellOptions options;
   options.objects_touch_table = false;
