@@ -304,20 +304,7 @@ Result<void> Optimizer::BuildSequence() {
 int Optimizer::BranchOf(int robot, const JointVector& q) const {
   const TaskRobot& tr = world_.robots[robot];
   if (tr.ur) {
-    const Iso3 X_BT = tr.X_BW * TcpPose(tr.chain, tr.X_WB, q, tr.end_effector.X_FT);
-    UrIkOptions ik_options;
-    ik_options.q6_if_singular = q[5];
-    const UrIkSolutions solutions = tr.ur->SolveTcp(X_BT, tr.end_effector.X_FT, ik_options);
-    int best = -1;
-    double nearest = kInf;
-    for (int i = 0; i < solutions.count; ++i) {
-      const double d = JointDistanceMax(tr.chain, solutions.q[i], q, true);
-      if (d < nearest) {
-        nearest = d;
-        best = solutions.branch[i];
-      }
-    }
-    return best;
+    return tr.ur->BranchOf(tr.chain, q);
   }
   int branch = 0;
   const int dof = tr.chain.dof();

@@ -82,8 +82,6 @@ class Builder {
       const std::vector<int>& robots, const std::vector<JointVector>& q0,
       const std::vector<std::function<Iso3(double)>>& targets, int steps,
       const std::vector<JointVector>* goals = nullptr);
-  // Branch id of a UR arm's configuration (the closed form's solution nearest to it).
-  int UrBranch(int robot, const JointVector& q) const;
   // Collision-free straight joint motion between consecutive waypoints (scene already set).
   bool PathClear(const std::vector<int>& robots,
                  const std::vector<std::vector<JointVector>>& waypoints);
@@ -103,6 +101,14 @@ class Builder {
   }
   // Adds the segment with the robots' current openings, advancing cur_ to its last waypoint.
   void Push(GeoSegment seg);
+  // Adds a straight skill of `robots` (waypoints[k][i] for robots[i]) of Cartesian `length_m`
+  // done at `speed_mps`.
+  void PushSkill(SegmentKind kind, int action, bool main, std::vector<int> robots,
+                 std::vector<int> objects, std::vector<std::vector<JointVector>> waypoints,
+                 double length_m, double speed_mps);
+  // PushSkill of one robot's waypoints.
+  void PushSkill(SegmentKind kind, int action, bool main, int robot, int object,
+                 const std::vector<JointVector>& waypoints, double length_m, double speed_mps);
   // Fills seg.boxes (scene at the segment's start).
   void Sweep(GeoSegment& seg);
   // Backs robot r's TCP away from q along its approach axis (TCP z) by up to approach_m,
@@ -174,6 +180,29 @@ void Builder::Push(GeoSegment seg) {
   out_.push_back(std::move(seg));
 }
 
+void Builder::PushSkill(SegmentKind kind, int action, bool main, std::vector<int> robots,
+                        std::vector<int> objects, std::vector<std::vector<JointVector>> waypoints,
+                        double length_m, double speed_mps) {
+  GeoSegment seg;
+  seg.kind = kind;
+  seg.action = action;
+  seg.main = main;
+  seg.robots = std::move(robots);
+  seg.objects = std::move(objects);
+  seg.waypoints = std::move(waypoints);
+  seg.skill_length_m = length_m;
+  seg.skill_speed_mps = speed_mps;
+  Push(std::move(seg));
+}
+
+void Builder::PushSkill(SegmentKind kind, int action, bool main, int robot, int object,
+                        const std::vector<JointVector>& waypoints, double length_m,
+                        double speed_mps) {
+  std::vector<std::vector<JointVector>> composite;
+  for (const JointVector& q : waypoints) composite.push_back({q});
+  PushSkill(kind, action, main, {robot}, {object}, std::move(composite), length_m, speed_mps);
+}
+
 void Builder::Sweep(GeoSegment& seg) {
   // Samples no farther apart than kSweepStep in the sum of joint changes: with links at most
   // kLever from their joints, a body point between two samples lies within kSweepMargin of one.
@@ -237,22 +266,6 @@ void Builder::Sweep(GeoSegment& seg) {
   seg.sweep = std::move(sweep);
 }
 
-int Builder::UrBranch(int robot, const JointVector& q) const {
-  const TaskRobot& r = w_.robots[robot];
-  const UrIkSolutions sols = r.ur->SolveTcp(r.X_BW * Tcp(robot, q), r.end_effector.X_FT);
-  int best = -1;
-  double best_d = 1e9;
-  for (int k = 0; k < sols.count; ++k) {
-    const JointVector e = NearestEquivalent(r.chain, sols.q[k], q);
-    const double d = (e - q).cwiseAbs().maxCoeff();
-    if (d < best_d) {
-      best_d = d;
-      best = sols.branch[k];
-    }
-  }
-  return best;
-}
-
 std::vector<std::vector<JointVector>> Builder::Track(
     const std::vector<int>& robots, const std::vector<JointVector>& q0,
     const std::vector<std::function<Iso3(double)>>& targets, int steps,
@@ -268,7 +281,7 @@ std::vector<std::vector<JointVector>> Builder::Track(
     JointVector q = q0[i];
     out[0][i] = q;
     // UR arms: the closed form on the start's branch (continuous away from singularities).
-    const int branch = r.ur ? UrBranch(robots[i], q) : -1;
+    const int branch = r.ur ? r.ur->BranchOf(r.chain, q) : -1;
     for (int k = 1; k <= steps; ++k) {
       const double s = static_cast<double>(k) / steps;
       const Iso3 X_BT = r.X_BW * targets[i](s);
@@ -382,15 +395,7 @@ bool Builder::Retreat(int action, int robot) {
                 Name(robot) + " cannot back its gripper away from " + NodeName(node) +
                     " along the gripper axis: " + last_hit_);
   }
-  GeoSegment seg;
-  seg.kind = SegmentKind::kRetreat;
-  seg.action = action;
-  seg.robots = {robot};
-  seg.objects = {node};
-  for (JointVector& q : back) seg.waypoints.push_back({q});
-  seg.skill_length_m = length;
-  seg.skill_speed_mps = opt_.skill_speed_mps;
-  Push(std::move(seg));
+  PushSkill(SegmentKind::kRetreat, action, false, robot, node, back, length, opt_.skill_speed_mps);
   released_[robot] = -1;
   return true;
 }
@@ -543,7 +548,8 @@ bool Builder::Lift(int action, int node, const std::vector<int>& holders) {
   const Vec3 back = -Tcp(holders[0], cur_[holders[0]]).linear().col(2);
   std::vector<std::pair<Vec3, double>> moves = {{Vec3::UnitZ(), opt_.lift_m}};
   if (back.z() > 0.3) moves.push_back({back, opt_.lift_m / back.z()});
-  for (const Vec3 side : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0)}) {
+  for (const Vec3& side :
+       std::array<Vec3, 4>{Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0)}) {
     moves.push_back({(side + Vec3::UnitZ()).normalized(), opt_.lift_m * std::sqrt(2.0)});
   }
   moves.push_back({Vec3::UnitZ(), opt_.lift_m / 2});
@@ -570,16 +576,8 @@ bool Builder::Lift(int action, int node, const std::vector<int>& holders) {
       why = last_hit_;
       continue;
     }
-    GeoSegment seg;
-    seg.kind = SegmentKind::kLift;
-    seg.action = action;
-    seg.main = true;
-    seg.robots = holders;
-    seg.objects = {node};
-    seg.waypoints = std::move(path);
-    seg.skill_length_m = d;
-    seg.skill_speed_mps = opt_.skill_speed_mps;
-    Push(std::move(seg));
+    PushSkill(SegmentKind::kLift, action, true, holders, {node}, std::move(path), d,
+              opt_.skill_speed_mps);
     grounded_.erase(node);
     return true;
   }
@@ -667,16 +665,8 @@ bool Builder::Carry(int action, int node, const std::vector<int>& holders, const
       continue;
     }
     for (const auto& [i, q] : rebranch) Rebranch(holders[i], action, approach, goal_q[i], q);
-    GeoSegment seg;
-    seg.kind = SegmentKind::kCarry;
-    seg.action = action;
-    seg.main = true;
-    seg.robots = holders;
-    seg.objects = {node};
-    seg.waypoints = std::move(path);
-    seg.skill_length_m = variant == 3 ? dist + 0.2 : std::max(dist, angle * 0.1);
-    seg.skill_speed_mps = opt_.carry_speed_mps;
-    Push(std::move(seg));
+    PushSkill(SegmentKind::kCarry, action, true, holders, {node}, std::move(path),
+              variant == 3 ? dist + 0.2 : std::max(dist, angle * 0.1), opt_.carry_speed_mps);
     return true;
   }
   return Fail(action, SegmentKind::kCarry, false,
@@ -924,16 +914,8 @@ bool Builder::Action(int i) {
   }
   // The final skills.
   if (a.type == ActionType::kPlace) {
-    GeoSegment seg;
-    seg.kind = SegmentKind::kDescend;
-    seg.action = i;
-    seg.main = true;
-    seg.robots = {a.robots[0]};
-    seg.objects = {grasped};
-    for (const JointVector& q : descend) seg.waypoints.push_back({q});
-    seg.skill_length_m = opt_.lift_m;
-    seg.skill_speed_mps = opt_.skill_speed_mps;
-    Push(std::move(seg));
+    PushSkill(SegmentKind::kDescend, i, true, a.robots[0], grasped, descend, opt_.lift_m,
+              opt_.skill_speed_mps);
   }
   if (assemble && a.approach) {
     const int m_node = a.objects[0];
@@ -975,28 +957,12 @@ bool Builder::Action(int i) {
                   "the insertion of " + NodeName(m_node) + " into " + NodeName(b_node) +
                       " is not a collision-free straight move: " + last_hit_);
     }
-    GeoSegment seg;
-    seg.kind = SegmentKind::kInsert;
-    seg.action = i;
-    seg.main = true;
-    seg.robots = inserters;
-    seg.objects = {m_node, b_node};
-    seg.waypoints = std::move(path);
-    seg.skill_length_m = len;
-    seg.skill_speed_mps = opt_.insert_speed_mps;
-    Push(std::move(seg));
+    PushSkill(SegmentKind::kInsert, i, true, inserters, {m_node, b_node}, std::move(path), len,
+              opt_.insert_speed_mps);
   }
   for (size_t k = 0; k < graspers.size(); ++k) {
-    GeoSegment seg;
-    seg.kind = SegmentKind::kApproach;
-    seg.action = i;
-    seg.main = true;
-    seg.robots = {graspers[k]};
-    seg.objects = {grasped};
-    for (const JointVector& q : approaches[k]) seg.waypoints.push_back({q});
-    seg.skill_length_m = approach_len[k];
-    seg.skill_speed_mps = opt_.skill_speed_mps;
-    Push(std::move(seg));
+    PushSkill(SegmentKind::kApproach, i, true, graspers[k], grasped, approaches[k], approach_len[k],
+              opt_.skill_speed_mps);
   }
   // Every robot is now at the keyframe (a robot whose keyframe joints differ from where it is by
   // whole turns only is where the keyframe wants it: the keyframes follow it).

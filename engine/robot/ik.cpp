@@ -287,6 +287,22 @@ UrIkSolutions UrAnalyticIk::Solve(const Iso3& X_BF, const UrIkOptions& options) 
   return out;
 }
 
+int UrAnalyticIk::BranchOf(const Chain& chain, const JointVector& q) const {
+  UrIkOptions options;
+  options.q6_if_singular = q[5];
+  const UrIkSolutions sols = Solve(FlangePose(chain, Iso3::Identity(), q), options);
+  int best = -1;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < sols.count; ++k) {
+    const double d = (NearestEquivalent(chain, sols.q[k], q) - q).cwiseAbs().maxCoeff();
+    if (d < nearest) {
+      nearest = d;
+      best = sols.branch[k];
+    }
+  }
+  return best;
+}
+
 UrIkSolutions UrAnalyticIk::SolveTcp(const Iso3& X_BT, const Iso3& X_FT,
                                      const UrIkOptions& options) const {
   return Solve(X_BT * X_FT.inverse(), options);

@@ -76,6 +76,11 @@ class UrAnalyticIk {
   /// flange frame (solves for X_BF = X_BT X_FT^-1).
   UrIkSolutions SolveTcp(const Iso3& X_BT, const Iso3& X_FT, const UrIkOptions& options = {}) const;
 
+  /// The branch (as in UrIkSolutions::branch) of configuration `q` of `chain`: that of the
+  /// closed-form solution nearest to q (revolute joints modulo 2 pi) for q's own flange pose;
+  /// -1 when there is none. Along a smooth motion away from singularities it does not change.
+  int BranchOf(const Chain& chain, const JointVector& q) const;
+
  private:
   UrAnalyticIk() = default;
   UrParameters p_;

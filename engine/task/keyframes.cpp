@@ -358,22 +358,6 @@ bool KeyframeSolver::SolveIk(int robot, const Iso3& X_WT, const JointVector& ref
   return !out.empty();
 }
 
-int KeyframeSolver::UrBranch(int robot, const JointVector& q) const {
-  const TaskRobot& r = world_.robots[robot];
-  const Iso3 X_BT = r.X_BW * TcpPose(r.chain, r.X_WB, q, r.end_effector.X_FT);
-  const UrIkSolutions sols = r.ur->SolveTcp(X_BT, r.end_effector.X_FT);
-  int best = -1;
-  double best_d = 1e9;
-  for (int k = 0; k < sols.count; ++k) {
-    const double d = (NearestEquivalent(r.chain, sols.q[k], q) - q).cwiseAbs().maxCoeff();
-    if (d < best_d) {
-      best_d = d;
-      best = sols.branch[k];
-    }
-  }
-  return best;
-}
-
 void KeyframeSolver::SetRobot(int robot, const JointVector& q) {
   ForwardKinematics(world_.robots[robot].chain, world_.robots[robot].X_WB, q, frames_[robot]);
   cell_.SetConfiguration(robot, std::span<const double>(q.data(), q.size()), frames_[robot]);
@@ -831,9 +815,10 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
           std::count_if(movers.begin(), movers.end(), [&](const Mover& x) {
             return x.node == m.node && s.held[x.robot] == x.node;
           }) >= 2) {
-        const int branch = UrBranch(m.robot, c.q[m.robot]);
+        const TaskRobot& rr = world_.robots[m.robot];
+        const int branch = rr.ur->BranchOf(rr.chain, c.q[m.robot]);
         std::erase_if(sols[i],
-                      [&](const JointVector& q) { return UrBranch(m.robot, q) != branch; });
+                      [&](const JointVector& q) { return rr.ur->BranchOf(rr.chain, q) != branch; });
         if (sols[i].empty()) {
           note(Gate::kIk, "'" + world_.robots[m.robot].name +
                               "' cannot carry its object there with the others on its IK branch");

@@ -121,8 +121,6 @@ class KeyframeSolver {
   void SetScene(const std::vector<PlanObject>& objects,
                 const std::vector<std::pair<int, int>>& holds, int allow_a, int allow_b);
   void SetRobot(int robot, const JointVector& q);
-  // Branch id of a UR arm's configuration (the closed form's solution nearest to it).
-  int UrBranch(int robot, const JointVector& q) const;
   void EnableRobot(int robot, bool on);
   bool Collides();
   bool Search(const std::vector<Mover>& movers, const std::vector<std::vector<JointVector>>& sols,

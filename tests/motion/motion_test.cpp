@@ -224,10 +224,13 @@ INSTANTIATE_TEST_SUITE_P(Examples, ExampleMotion,
                          ::testing::Values("stool", "half_stool", "cross", "fabrica_beam",
                                            "fabrica_car"));
 
+// Deterministic as long as no path search runs out of time (a time budget depends on the
+// machine's load): half_stool's searches take milliseconds.
 TEST(Motion, SameSeedSameTrajectories) {
-  const Planned& p = PlanOnce("stool");
+  const Planned& p = PlanOnce("half_stool");
   ASSERT_TRUE(p.error.empty()) << p.error;
   ASSERT_TRUE(p.plan->stats.solved) << p.plan->stats.failure;
+  EXPECT_EQ(p.plan->stats.motion_suspensions, 0);
   std::string error;
   const Plan again = RunPipeline(p, 1, &error);
   ASSERT_TRUE(error.empty()) << error;
