@@ -110,6 +110,20 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
                  "Stop after the task plan: no keyframe optimisation, motion planning or "
                  "retiming");
 
+  // No subcommand: the GUI, optionally on a project, with its headless hooks.
+  GuiArgs gui;
+  double gui_at = 0.0;
+  app.add_option("PROJECT", gui.project, "Project to open in the GUI (no subcommand)");
+  app.add_option("--screenshot", gui.screenshot,
+                 "GUI: draw a few frames, save the whole window as this PNG and exit");
+  app.add_flag("--run-plan", gui.run_plan, "GUI with --screenshot: plan first");
+  CLI::Option* gui_at_option =
+      app.add_option("--at", gui_at, "GUI with --screenshot: the timeline's time [s]");
+  app.add_option("--size", gui.size, "GUI window size WIDTHxHEIGHT [px] (default 1600x960)");
+  app.add_option("--script", gui.script,
+                 "GUI: run this file of UI commands (select, set, add-edge, run, scrub, save, "
+                 "...) and exit");
+
   // CLI11 takes arguments in reverse order.
   std::vector<std::string> reversed(args.rbegin(), args.rend());
   try {
@@ -131,9 +145,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (plan_time_option->count() > 0) plan_args.time_limit = plan_time_limit;
     return PlanCommand(plan_args, out, err);
   }
-  // No subcommand: the GUI will open here once it exists; until then explain what there is.
-  out << app.help();
-  return 0;
+  if (gui_at_option->count() > 0) gui.at = gui_at;
+  return Gui(gui, out, err);
 }
 
 }  // namespace wrap::cli

@@ -29,8 +29,8 @@ int Validate(const std::string& project, const std::string& plan, bool quiet, st
 /// the issues to `err`, or a one-line summary to `out`. Returns the exit code (0 valid, 1 not,
 /// 2 or 3 when the plan cannot be interpreted).
 
-int ReportPlanValidation(const LoadedProject& loaded, const Plan& plan,
-                         const std::string& project, std::ostream& out, std::ostream& err);
+int ReportPlanValidation(const LoadedProject& loaded, const Plan& plan, const std::string& project,
+                         std::ostream& out, std::ostream& err);
 
 /// `wrap info PROJECT`: parts with mass and size, the DAG as a tree, robots and end effectors.
 int Info(const std::string& project, std::ostream& out, std::ostream& err);
@@ -90,5 +90,20 @@ struct RenderArgs {
 /// optionally a video; exit 0, 2 bad input (bad option, unwritable folder, GL backend or ffmpeg
 /// unavailable, invalid project, a plan that is malformed or for another project), 3 internal.
 int Render(const RenderArgs& args, std::ostream& out, std::ostream& err);
+
+/// Arguments of the GUI (`wrap` without a subcommand).
+struct GuiArgs {
+  std::string project;       ///< PROJECT to open; empty: a new project.
+  std::string screenshot;    ///< --screenshot FILE.png: draw a few frames, save, exit.
+  bool run_plan = false;     ///< --run-plan: plan before the screenshot.
+  std::optional<double> at;  ///< --at T: timeline time of the screenshot [s].
+  std::string size;          ///< --size WIDTHxHEIGHT of the window; empty: 1600x960.
+  std::string script;        ///< --script FILE: UI commands to run, then exit.
+};
+
+/// `wrap [PROJECT]`: opens the GUI (or, with --screenshot or --script, runs it headless under
+/// X/Xvfb and exits); exit 0, 1 no plan (--run-plan) or a failed script line, 2 bad input or
+/// no display, 3 internal.
+int Gui(const GuiArgs& args, std::ostream& out, std::ostream& err);
 
 }  // namespace wrap::cli

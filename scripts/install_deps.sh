@@ -23,6 +23,8 @@ PACKAGES=(
   libgl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libimgui-dev
   # tests and benchmarks
   libgtest-dev libbenchmark-dev
+  # GUI tests: a virtual X server for the window (xvfb-run needs xauth)
+  xvfb xauth
 )
 
 missing=()

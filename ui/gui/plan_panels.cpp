@@ -1,0 +1,192 @@
+// The planner panel (options, Run/Cancel, progress, log, errors) and the plan panel (actions in
+// words, timeline with play/pause/speed/loop, scrubber, per-robot lanes).
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "gui/panels.h"
+
+namespace wrap::gui {
+
+double AppState::Duration() const {
+  if (!plan) return 0.0;
+  if (plan->stats.motion && !plan->trajectories.empty()) {
+    double end = plan->stats.makespan_s;
+    for (const RobotTrajectory& tr : plan->trajectories) {
+      if (!tr.knots.empty()) end = std::max(end, tr.knots.back().t);
+    }
+    return end;
+  }
+  int keyframes = 1;
+  for (const PlanAction& a : plan->actions) keyframes += a.approach ? 2 : 1;
+  return static_cast<double>(keyframes - 1);
+}
+
+void PlannerPanel::Draw(AppState& app, const PanelRect& r) {
+  PlaceNextWindow(r);
+  if (!ImGui::Begin("Planner", nullptr, ImGuiWindowFlags_NoCollapse)) {
+    ImGui::End();
+    return;
+  }
+  PlannerRequest& q = app.request;
+  static const char* kPlanners[] = {"wrap", "optimistic", "flat", "counting", "exact", "fine"};
+  static const char* kWrench[] = {"full", "gravity", "none"};
+  const bool running = app.job.running();
+  ImGui::BeginDisabled(running);
+  ImGui::SetNextItemWidth(120);
+  if (ImGui::BeginCombo("variant", q.planner.c_str())) {
+    for (const char* v : kPlanners) {
+      if (ImGui::Selectable(v, q.planner == v)) q.planner = v;
+    }
+    ImGui::EndCombo();
+  }
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(90);
+  if (ImGui::BeginCombo("wrench", q.wrench.c_str())) {
+    for (const char* v : kWrench) {
+      if (ImGui::Selectable(v, q.wrench == v)) q.wrench = v;
+    }
+    ImGui::EndCombo();
+  }
+  ImGui::SetNextItemWidth(120);
+  ImGui::InputDouble("time limit [s]", &q.time_limit_s, 1.0, 10.0, "%.0f");
+  q.time_limit_s = std::clamp(q.time_limit_s, 1.0, 36000.0);
+  ImGui::SetNextItemWidth(120);
+  ImGui::InputScalar("seed", ImGuiDataType_U64, &q.seed);
+  ImGui::SetNextItemWidth(120);
+  ImGui::InputDouble("force scale", &q.force_scale, 0.1, 1.0, "%.2f");
+  q.force_scale = std::clamp(q.force_scale, 0.0, 1e6);
+  ImGui::Checkbox("optimize", &q.optimize);
+  ImGui::SameLine();
+  ImGui::Checkbox("task only (no motion)", &q.task_only);
+  ImGui::EndDisabled();
+
+  if (!running) {
+    if (ImGui::Button("Run", ImVec2(90, 0))) {
+      app.job.Start(app.doc.project(), app.doc.ResolvePath(), q);
+      app.Notify("Planning started on a snapshot of the project");
+    }
+  } else if (ImGui::Button("Cancel", ImVec2(90, 0))) {
+    app.job.Cancel();
+  }
+  const JobProgress prog = app.job.progress();
+  ImGui::SameLine();
+  ImGui::Text("%s  %.1f s", ToString(prog.state), prog.elapsed_s);
+  if (prog.state == JobState::kRunning) {
+    const float f = prog.fraction >= 0 ? static_cast<float>(prog.fraction)
+                                       : static_cast<float>(std::fmod(prog.elapsed_s, 1.0));
+    ImGui::ProgressBar(f, ImVec2(-1, 0), (prog.stage + ": " + prog.message).c_str());
+  }
+  if (!prog.error.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
+    ImGui::TextWrapped("%s", prog.error.c_str());
+    ImGui::PopStyleColor();
+  }
+  ImGui::BeginChild("log", ImVec2(0, 0), true);
+  for (const std::string& line : prog.log) ImGui::TextWrapped("%s", line.c_str());
+  if (prog.state == JobState::kRunning) ImGui::SetScrollHereY(1.0f);
+  ImGui::EndChild();
+  ImGui::End();
+}
+
+void PlanPanel::Draw(AppState& app, const PanelRect& r) {
+  PlaceNextWindow(r);
+  if (!ImGui::Begin("Plan", nullptr, ImGuiWindowFlags_NoCollapse)) {
+    ImGui::End();
+    return;
+  }
+  if (!app.plan) {
+    ImGui::TextDisabled("No plan yet: run the planner (Planner panel) or open a plan file.");
+    ImGui::End();
+    return;
+  }
+  const Plan& plan = *app.plan;
+  const bool motion = plan.stats.motion && !plan.trajectories.empty();
+  const double duration = app.Duration();
+  Playback& pb = app.playback;
+  if (ImGui::Button(pb.playing ? "Pause" : "Play", ImVec2(60, 0))) pb.playing = !pb.playing;
+  ImGui::SameLine();
+  if (ImGui::Button("|<")) pb.t = 0;
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(90);
+  float speed = static_cast<float>(pb.speed);
+  if (ImGui::SliderFloat("speed", &speed, 0.1f, 8.0f, "%.1fx", ImGuiSliderFlags_Logarithmic)) {
+    pb.speed = speed;
+  }
+  ImGui::SameLine();
+  ImGui::Checkbox("loop", &pb.loop);
+  ImGui::SameLine();
+  ImGui::Text(
+      "%s, cost %d, %s", plan.stats.solved ? "solved" : "not solved", plan.stats.cost,
+      motion ? ("makespan " + std::to_string(plan.stats.makespan_s).substr(0, 5) + " s").c_str()
+             : "keyframes only");
+  ImGui::SetNextItemWidth(-1);
+  float t = static_cast<float>(pb.t);
+  if (ImGui::SliderFloat("##time", &t, 0.0f, static_cast<float>(std::max(duration, 1e-3)),
+                         motion ? "t = %.2f s" : "keyframe %.0f")) {
+    pb.t = t;
+    pb.playing = false;
+  }
+
+  // Lanes: one per robot, a bar per action it takes part in (start..end with motion; one
+  // keyframe wide without).
+  const int n_robots = static_cast<int>(plan.robots.size());
+  const float lane_h = 14.0f;
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  const ImVec2 origin = ImGui::GetCursorScreenPos();
+  const float label_w = 80.0f;
+  const float width = std::max(50.0f, ImGui::GetContentRegionAvail().x - label_w);
+  auto x_of = [&](double time) {
+    return origin.x + label_w + static_cast<float>(time / std::max(duration, 1e-9)) * width;
+  };
+  std::vector<double> keyframe_time(plan.actions.size());
+  double k = 0;
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    k += plan.actions[i].approach ? 2 : 1;
+    keyframe_time[i] = motion ? plan.actions[i].end_s : k;
+  }
+  for (int rb = 0; rb < n_robots; ++rb) {
+    const float y = origin.y + rb * (lane_h + 3);
+    dl->AddText(ImVec2(origin.x, y), IM_COL32(200, 200, 200, 255), plan.robots[rb].c_str());
+    dl->AddRectFilled(ImVec2(origin.x + label_w, y), ImVec2(origin.x + label_w + width, y + lane_h),
+                      IM_COL32(40, 42, 46, 255));
+    for (size_t i = 0; i < plan.actions.size(); ++i) {
+      const PlanAction& a = plan.actions[i];
+      if (std::find(a.robots.begin(), a.robots.end(), rb) == a.robots.end()) continue;
+      const double end = keyframe_time[i];
+      const double start = motion ? std::max(0.0, a.start_s) : end - (a.approach ? 2 : 1);
+      const ImU32 col = a.type == ActionType::kAssemble ? IM_COL32(230, 140, 50, 255)
+                        : a.type == ActionType::kPick   ? IM_COL32(80, 150, 220, 255)
+                                                        : IM_COL32(120, 180, 120, 255);
+      dl->AddRectFilled(ImVec2(x_of(start), y + 1),
+                        ImVec2(std::max(x_of(end), x_of(start) + 2), y + lane_h - 1), col, 2.0f);
+    }
+  }
+  const float lanes_h = n_robots * (lane_h + 3);
+  dl->AddLine(ImVec2(x_of(pb.t), origin.y), ImVec2(x_of(pb.t), origin.y + lanes_h),
+              IM_COL32(255, 255, 255, 255), 2.0f);
+  ImGui::InvisibleButton("lanes", ImVec2(label_w + width, std::max(lanes_h, 1.0f)));
+  if (ImGui::IsItemActive()) {
+    const double f = (ImGui::GetIO().MousePos.x - origin.x - label_w) / width;
+    pb.t = std::clamp(f, 0.0, 1.0) * duration;
+    pb.playing = false;
+  }
+
+  // Actions in words; click to jump to the action's moment.
+  ImGui::BeginChild("actions", ImVec2(0, 0), true);
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    const double at = keyframe_time[i];
+    const double from = motion ? plan.actions[i].start_s : at - 1;
+    const bool current = pb.t >= from && pb.t <= at;
+    const std::string line = std::to_string(i + 1) + ". " + DescribeAction(plan, plan.actions[i]);
+    if (ImGui::Selectable(line.c_str(), current)) {
+      pb.t = at;
+      pb.playing = false;
+    }
+  }
+  ImGui::EndChild();
+  ImGui::End();
+}
+
+}  // namespace wrap::gui

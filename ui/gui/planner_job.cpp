@@ -1,0 +1,191 @@
+#include "gui/planner_job.h"
+
+#include <exception>
+
+#include "core/run_context.h"
+#include "grasp/preprocess.h"
+#include "model/validate.h"
+#include "pipeline/pipeline.h"
+#include "robot/robot_check.h"
+#include "task/planner.h"
+
+namespace wrap::gui {
+
+const char* ToString(JobState state) {
+  switch (state) {
+    case JobState::kIdle:
+      return "idle";
+    case JobState::kRunning:
+      return "running";
+    case JobState::kSolved:
+      return "solved";
+    case JobState::kNoPlan:
+      return "no plan";
+    case JobState::kFailed:
+      return "failed";
+    case JobState::kCancelled:
+      return "cancelled";
+  }
+  return "?";
+}
+
+PlannerJob::~PlannerJob() {
+  Cancel();
+  Wait();
+}
+
+bool PlannerJob::Start(Project project, std::filesystem::path project_file,
+                       PlannerRequest request) {
+  if (running()) return false;
+  if (worker_.joinable()) worker_.join();
+  {
+    std::lock_guard lock(mutex_);
+    progress_ = JobProgress{};
+    progress_.state = JobState::kRunning;
+    progress_.stage = "validate";
+    plan_.reset();
+    started_ = std::chrono::steady_clock::now();
+  }
+  worker_ = std::jthread([this, p = std::move(project), f = std::move(project_file),
+                          r = std::move(request)](std::stop_token stop) mutable {
+    Run(stop, std::move(p), std::move(f), std::move(r));
+  });
+  return true;
+}
+
+void PlannerJob::Cancel() {
+  if (worker_.joinable()) worker_.request_stop();
+}
+
+bool PlannerJob::running() const {
+  std::lock_guard lock(mutex_);
+  return progress_.state == JobState::kRunning;
+}
+
+void PlannerJob::Wait() {
+  if (worker_.joinable()) worker_.join();
+}
+
+JobProgress PlannerJob::progress() const {
+  std::lock_guard lock(mutex_);
+  JobProgress p = progress_;
+  if (p.state == JobState::kRunning) {
+    p.elapsed_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  }
+  return p;
+}
+
+std::shared_ptr<const Plan> PlannerJob::TakePlan() {
+  std::lock_guard lock(mutex_);
+  return std::exchange(plan_, nullptr);
+}
+
+void PlannerJob::Log(const std::string& line) {
+  std::lock_guard lock(mutex_);
+  progress_.log.push_back(line);
+}
+
+void PlannerJob::Finish(JobState state, std::string error, std::shared_ptr<const Plan> plan) {
+  std::lock_guard lock(mutex_);
+  progress_.state = state;
+  progress_.error = std::move(error);
+  progress_.elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  if (!progress_.error.empty()) progress_.log.push_back(progress_.error);
+  progress_.log.push_back(std::string("run ended: ") + ToString(state));
+  plan_ = std::move(plan);
+}
+
+// The catch barrier of the worker: whatever happens inside ends as a state and a message.
+void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::path file,
+                     PlannerRequest request) {
+  try {
+    RunContext ctx(request.seed);
+    ctx.set_stop_token(stop);
+    ctx.set_time_limit_s(request.time_limit_s);
+    ctx.set_progress([this](const std::string& stage, double fraction, const std::string& msg) {
+      std::lock_guard lock(mutex_);
+      progress_.stage = stage;
+      progress_.fraction = fraction;
+      progress_.message = msg;
+      progress_.log.push_back(stage + ": " + msg);
+    });
+    auto stage = [&](const char* name, const std::string& message) {
+      ctx.Progress(name, -1.0, message);
+    };
+    auto stopped = [&]() {
+      if (!ctx.cancelled()) return false;
+      Finish(JobState::kCancelled, "", nullptr);
+      return true;
+    };
+
+    stage("validate", "checking '" + project.name + "' (meshes, DAG, robots)");
+    ProjectCheck check = ValidateProject(project, file);
+    check.diagnostics.Append(CheckRobots(project, file));
+    if (check.diagnostics.has_errors()) {
+      std::string message = "the project is not valid:";
+      int shown = 0;
+      for (const Diagnostic& d : check.diagnostics.items) {
+        if (d.severity != Severity::kError) continue;
+        if (++shown > 8) break;
+        message += "\n  " + (d.path.empty() ? "" : d.path + ": ") + d.message;
+      }
+      Finish(JobState::kFailed, message, nullptr);
+      return;
+    }
+    if (stopped()) return;
+
+    TaskPlannerOptions task;
+    task.project_file = file;
+    task.planner = request.planner;
+    task.optimize = request.optimize;
+    task.force_scale = request.force_scale;
+    task.wrench_mode = request.wrench == "gravity" ? MatingWrenchMode::kGravityOnly
+                       : request.wrench == "none"  ? MatingWrenchMode::kNone
+                                                   : MatingWrenchMode::kFull;
+    stage("preprocess", "placements, table slots and grasp sets");
+    PreprocessOptions pre_options;
+    pre_options.project_file = file;
+    pre_options.grasps = request.grasps;
+    auto pre = Preprocess(project, check, pre_options, ctx);
+    if (stopped()) return;
+    if (!pre) {
+      Finish(JobState::kFailed, "preprocessing: " + pre.error().message, nullptr);
+      return;
+    }
+    for (const std::string& w : pre->warnings) Log("warning: " + w);
+
+    stage("task", "searching for a task plan (" + request.planner + ")");
+    PipelineOptions pipeline;
+    pipeline.task = task;
+    pipeline.task_only = request.task_only;
+    pipeline.seed = request.seed;
+    auto plan = PlanAssembly(project, check, *pre, pipeline, ctx);
+    if (stopped()) return;
+    if (!plan) {
+      const JobState state =
+          plan.error().code == ErrorCode::kCancelled ? JobState::kCancelled : JobState::kFailed;
+      Finish(state, plan.error().message, nullptr);
+      return;
+    }
+    plan->stats.seed = request.seed;
+    const PlanStats& st = plan->stats;
+    Log("cost " + std::to_string(st.cost) + ", " + std::to_string(plan->actions.size()) +
+        " actions" + (st.motion ? ", makespan " + std::to_string(st.makespan_s) + " s" : ""));
+    auto shared = std::make_shared<const Plan>(std::move(*plan));
+    if (st.solved) {
+      Finish(JobState::kSolved, "", shared);
+    } else {
+      // A task plan without motion still has keyframes worth showing.
+      Finish(JobState::kNoPlan, st.failure.empty() ? "no plan found" : st.failure,
+             shared->actions.empty() ? nullptr : shared);
+    }
+  } catch (const std::exception& e) {
+    Finish(JobState::kFailed, std::string("internal error: ") + e.what(), nullptr);
+  } catch (...) {
+    Finish(JobState::kFailed, "internal error: unknown exception", nullptr);
+  }
+}
+
+}  // namespace wrap::gui

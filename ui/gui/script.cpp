@@ -1,0 +1,330 @@
+#include "gui/script.h"
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <sstream>
+
+#include "gui/commands.h"
+
+namespace wrap::gui {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Command name -> (least, most) arguments.
+const std::map<std::string, std::pair<int, int>>& Arity() {
+  static const std::map<std::string, std::pair<int, int>> arity = {
+      {"select", {2, 2}},        {"import", {1, 2}},    {"add-step", {1, 1}},
+      {"delete-step", {1, 1}},   {"rename", {2, 2}},    {"add-edge", {2, 2}},
+      {"remove-edge", {2, 2}},   {"add-robot", {2, 2}}, {"remove-robot", {1, 1}},
+      {"set", {2, 5}},           {"undo", {0, 0}},      {"redo", {0, 0}},
+      {"option", {2, 2}},        {"run", {0, 0}},       {"wait", {0, 0}},
+      {"expect-plan", {0, 0}},   {"scrub", {1, 1}},     {"play", {0, 0}},
+      {"pause", {0, 0}},         {"save", {0, 1}},      {"screenshot", {1, 1}},
+      {"expect-refused", {1, 6}}};
+  return arity;
+}
+
+std::unexpected<Error> LineError(const ScriptLine& line, const std::string& message) {
+  return Fail(ErrorCode::kInvalidInput,
+              "script line " + std::to_string(line.number) + ": " + message);
+}
+
+Result<double> Number(const ScriptLine& line, const std::string& word) {
+  char* end = nullptr;
+  const double v = std::strtod(word.c_str(), &end);
+  if (word.empty() || *end != '\0' || !std::isfinite(v)) {
+    return LineError(line, "'" + word + "' is not a number");
+  }
+  return v;
+}
+
+Result<Vec3> Vector(const ScriptLine& line, size_t first) {
+  if (line.words.size() != first + 3) return LineError(line, "expected three numbers");
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) {
+    auto x = Number(line, line.words[first + i]);
+    if (!x) return std::unexpected(x.error());
+    v[i] = *x;
+  }
+  return v;
+}
+
+/// `set FIELD VALUE...`: the field path is KIND.NAME.FIELD (part, mating, robot) or
+/// KIND.FIELD (table, planner).
+Result<void> SetField(AppState& app, const ScriptLine& line) {
+  const std::string& path = line.words[1];
+  const auto dot1 = path.find('.');
+  const auto dot2 = path.rfind('.');
+  if (dot1 == std::string::npos) return LineError(line, "field '" + path + "' has no '.'");
+  const std::string kind = path.substr(0, dot1);
+  const std::string name = dot2 > dot1 ? path.substr(dot1 + 1, dot2 - dot1 - 1) : "";
+  const std::string field = path.substr(dot2 + 1);
+  const Project& p = app.doc.project();
+  auto scalar = [&]() { return Number(line, line.words[2]); };
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  auto unknown = [&]() { return LineError(line, "unknown field '" + path + "'"); };
+  auto run = [&](const Command& c) -> Result<void> {
+    if (auto done = app.doc.Execute(c); !done) return LineError(line, done.error().message);
+    app.doc.CloseMerge();
+    return {};
+  };
+
+  if (kind == "part") {
+    auto it =
+        std::find_if(p.parts.begin(), p.parts.end(), [&](const Part& q) { return q.name == name; });
+    if (it == p.parts.end()) return LineError(line, "there is no part '" + name + "'");
+    Part part = *it;
+    if (field == "mass_kg" || field == "density_kg_m3" || field == "scale") {
+      auto v = scalar();
+      if (!v) return std::unexpected(v.error());
+      if (field == "mass_kg") part.mass_kg = *v;
+      if (field == "density_kg_m3") part.density_kg_m3 = *v;
+      if (field == "scale") part.scale = *v;
+    } else if (field == "initial_xyz" || field == "initial_rpy_deg" || field == "color") {
+      auto v = Vector(line, 2);
+      if (!v) return std::unexpected(v.error());
+      if (field == "initial_xyz") part.initial_pose.xyz = *v;
+      if (field == "initial_rpy_deg") part.initial_pose.rpy = *v * kDeg;
+      if (field == "color") part.color = {v->x(), v->y(), v->z(), 1.0};
+    } else {
+      return unknown();
+    }
+    return run(SetPart(name, part));
+  }
+  if (kind == "mating") {
+    auto it =
+        std::find_if(p.steps.begin(), p.steps.end(), [&](const Step& s) { return s.name == name; });
+    if (it == p.steps.end()) return LineError(line, "there is no step '" + name + "'");
+    Mating m = it->mating;
+    if (field == "moved" || field == "base") {
+      (field == "moved" ? m.moved : m.base) = line.words[2];
+    } else if (field == "axis") {
+      auto v = Vector(line, 2);
+      if (!v) return std::unexpected(v.error());
+      m.axis = *v;
+    } else {
+      auto v = scalar();
+      if (!v) return std::unexpected(v.error());
+      if (field == "force_N")
+        m.force_N = *v;
+      else if (field == "torque_Nm")
+        m.torque_Nm = *v;
+      else if (field == "transverse_fraction")
+        m.transverse_fraction = *v;
+      else if (field == "offset_m")
+        m.offset_m = *v;
+      else if (field == "approach_m")
+        m.approach_m = *v;
+      else
+        return unknown();
+    }
+    return run(SetMating(name, m));
+  }
+  if (kind == "robot") {
+    auto it = std::find_if(p.robots.begin(), p.robots.end(),
+                           [&](const Robot& q) { return q.name == name; });
+    if (it == p.robots.end()) return LineError(line, "there is no robot '" + name + "'");
+    Robot robot = *it;
+    if (field == "end_effector") {
+      robot.end_effector = line.words[2];
+    } else if (field == "base_xyz" || field == "base_rpy_deg") {
+      auto v = Vector(line, 2);
+      if (!v) return std::unexpected(v.error());
+      if (field == "base_xyz")
+        robot.base_pose.xyz = *v;
+      else
+        robot.base_pose.rpy = *v * kDeg;
+    } else {
+      return unknown();
+    }
+    return run(SetRobot(name, robot));
+  }
+  if (kind == "table") {
+    Table t = p.table;
+    auto v = scalar();
+    if (!v) return std::unexpected(v.error());
+    if (field == "height")
+      t.height = *v;
+    else if (field == "friction")
+      t.friction = *v;
+    else
+      return unknown();
+    return run(SetTable(t));
+  }
+  if (kind == "planner") {
+    PlannerDefaults d = p.planner;
+    auto v = scalar();
+    if (!v) return std::unexpected(v.error());
+    if (field == "time_limit_s")
+      d.time_limit_s = *v;
+    else if (field == "seed")
+      d.seed = static_cast<std::uint64_t>(*v);
+    else if (field == "grasps")
+      d.grasps = static_cast<int>(*v);
+    else
+      return unknown();
+    return run(SetPlannerDefaults(d));
+  }
+  return unknown();
+}
+
+}  // namespace
+
+Result<std::vector<ScriptLine>> ParseScript(const std::string& text) {
+  std::vector<ScriptLine> lines;
+  std::istringstream in(text);
+  std::string raw;
+  int number = 0;
+  while (std::getline(in, raw)) {
+    ++number;
+    if (auto hash = raw.find('#'); hash != std::string::npos) raw.resize(hash);
+    ScriptLine line{number, {}};
+    std::istringstream words(raw);
+    for (std::string w; words >> w;) line.words.push_back(w);
+    if (line.words.empty()) continue;
+    auto it = Arity().find(line.words[0]);
+    if (it == Arity().end()) return LineError(line, "unknown command '" + line.words[0] + "'");
+    const int args = static_cast<int>(line.words.size()) - 1;
+    if (args < it->second.first || args > it->second.second) {
+      return LineError(line, "'" + line.words[0] + "' takes " + std::to_string(it->second.first) +
+                                 (it->second.second != it->second.first
+                                      ? " to " + std::to_string(it->second.second)
+                                      : std::string()) +
+                                 " argument(s), got " + std::to_string(args));
+    }
+    lines.push_back(std::move(line));
+  }
+  return lines;
+}
+
+Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const fs::path& base) {
+  const std::vector<std::string>& w = line.words;
+  const std::string& cmd = w[0];
+  ScriptEffect effect;
+  auto run = [&](const Command& c) -> Result<ScriptEffect> {
+    if (auto done = app.doc.Execute(c); !done) return LineError(line, done.error().message);
+    return effect;
+  };
+  auto resolve = [&](const std::string& f) {
+    return fs::path(f).is_absolute() ? fs::path(f) : base / f;
+  };
+
+  if (cmd == "select") {
+    if (w[1] == "part")
+      app.selection.part = w[2];
+    else if (w[1] == "step")
+      app.selection.step = w[2];
+    else if (w[1] == "robot")
+      app.selection.robot = w[2];
+    else
+      return LineError(line, "select part|step|robot NAME");
+    return effect;
+  }
+  if (cmd == "import") {
+    PartImportOptions options;
+    if (w.size() > 2) {
+      auto unit = std::find_if(MeshUnits().begin(), MeshUnits().end(),
+                               [&](const MeshUnit& u) { return w[2] == u.name; });
+      if (unit == MeshUnits().end()) return LineError(line, "unit must be m, cm, mm or inch");
+      options.scale = unit->scale;
+    }
+    auto part = PreparePartImport(app.doc.project(), app.doc.ResolvePath(), resolve(w[1]), options);
+    if (!part) return LineError(line, part.error().message);
+    app.selection.part = part->name;
+    return run(AddPart(*part));
+  }
+  if (cmd == "add-step") return run(AddStep(w[1]));
+  if (cmd == "delete-step") return run(RemoveStep(w[1]));
+  if (cmd == "rename") return run(RenameNode(w[1], w[2]));
+  if (cmd == "add-edge") return run(AddInput(w[2], w[1]));
+  if (cmd == "remove-edge") return run(RemoveInput(w[2], w[1]));
+  if (cmd == "add-robot") return run(AddRobot(w[1], w[2]));
+  if (cmd == "remove-robot") return run(RemoveRobot(w[1]));
+  if (cmd == "set") {
+    if (auto done = SetField(app, line); !done) return std::unexpected(done.error());
+    return effect;
+  }
+  if (cmd == "undo") {
+    if (!app.doc.Undo()) return LineError(line, "nothing to undo");
+    return effect;
+  }
+  if (cmd == "redo") {
+    if (!app.doc.Redo()) return LineError(line, "nothing to redo");
+    return effect;
+  }
+  if (cmd == "option") {
+    PlannerRequest& q = app.request;
+    const std::string& v = w[2];
+    if (w[1] == "planner")
+      q.planner = v;
+    else if (w[1] == "wrench")
+      q.wrench = v;
+    else if (w[1] == "time_limit_s")
+      q.time_limit_s = std::atof(v.c_str());
+    else if (w[1] == "seed")
+      q.seed = std::strtoull(v.c_str(), nullptr, 10);
+    else if (w[1] == "task_only")
+      q.task_only = v == "1" || v == "true";
+    else if (w[1] == "grasps")
+      q.grasps = std::atoi(v.c_str());
+    else
+      return LineError(line, "unknown planner option '" + w[1] + "'");
+    return effect;
+  }
+  if (cmd == "run") {
+    if (!app.job.Start(app.doc.project(), app.doc.ResolvePath(), app.request)) {
+      return LineError(line, "the planner is already running");
+    }
+    return effect;
+  }
+  if (cmd == "wait") {
+    effect.wait_for_planner = true;
+    return effect;
+  }
+  if (cmd == "expect-plan") {
+    if (!app.plan || !app.plan->stats.solved) {
+      const JobProgress prog = app.job.progress();
+      return LineError(line, "no solved plan (" + std::string(ToString(prog.state)) +
+                                 (prog.error.empty() ? "" : ": " + prog.error) + ")");
+    }
+    return effect;
+  }
+  if (cmd == "scrub") {
+    auto t = Number(line, w[1]);
+    if (!t) return std::unexpected(t.error());
+    app.playback.t = std::clamp(*t, 0.0, app.Duration());
+    app.playback.playing = false;
+    return effect;
+  }
+  if (cmd == "play" || cmd == "pause") {
+    app.playback.playing = cmd == "play";
+    return effect;
+  }
+  if (cmd == "save") {
+    auto saved = w.size() > 1 ? app.doc.SaveAs(resolve(w[1])) : app.doc.Save();
+    if (!saved) return LineError(line, saved.error().message);
+    return effect;
+  }
+  if (cmd == "screenshot") {
+    effect.screenshot = resolve(w[1]);
+    return effect;
+  }
+  if (cmd == "expect-refused") {
+    ScriptLine inner{line.number, std::vector<std::string>(w.begin() + 1, w.end())};
+    auto it = Arity().find(inner.words[0]);
+    if (it == Arity().end()) return LineError(line, "unknown command '" + inner.words[0] + "'");
+    const Project before = app.doc.project();
+    auto r = RunScriptLine(app, inner, base);
+    if (r) return LineError(line, "'" + inner.words[0] + "' was not refused");
+    if (!(app.doc.project() == before))
+      return LineError(line, "a refused command changed the project");
+    app.Notify("Refused as expected: " + r.error().message);
+    return effect;
+  }
+  return LineError(line, "unknown command '" + cmd + "'");
+}
+
+}  // namespace wrap::gui

@@ -1,0 +1,52 @@
+// The scripted mode of the GUI (`wrap PROJECT --script FILE`): a small list of UI commands, one
+// per line, run one per frame against the same AppState the panels edit, so that GUI flows are
+// tested in CI. '#' starts a comment. Commands:
+//   select part|step|robot NAME        set the shared selection
+//   import MESH [m|cm|mm|inch]         import a mesh as a part (relative to the script's folder)
+//   add-step NAME | delete-step NAME | rename OLD NEW
+//   add-edge INPUT STEP | remove-edge INPUT STEP     inputs of a step (cycles are refused)
+//   add-robot MODEL END_EFFECTOR | remove-robot NAME
+//   set FIELD VALUE...                 a field, e.g. `set part.seat.mass_kg 0.2`,
+//                                      `set mating.s1.axis 0 0 1`, `set robot.r1.base_xyz 0 0 .75`
+//   undo | redo
+//   option NAME VALUE                  planner option: planner, wrench, time_limit_s, seed,
+//                                      task_only (0/1), grasps
+//   run                                start the planner on the document (non-blocking)
+//   wait                               wait until the planner ends (frames keep drawing)
+//   expect-plan                        fail unless the last run gave a solved plan
+//   scrub T | play | pause             the timeline [s, or keyframe index without motion]
+//   save [FILE] | screenshot FILE      (relative to the script's folder)
+//   expect-refused COMMAND...          run COMMAND and fail unless it is refused
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/result.h"
+#include "gui/app_state.h"
+
+namespace wrap::gui {
+
+/// One line of a script, split into words.
+struct ScriptLine {
+  int number = 0;                  ///< Line number in the file, from 1.
+  std::vector<std::string> words;  ///< The command and its arguments.
+};
+
+/// Splits a script into command lines (skipping blanks and comments). Fails with kInvalidInput
+/// naming the line for an unknown command or a wrong number of arguments.
+Result<std::vector<ScriptLine>> ParseScript(const std::string& text);
+
+/// What a line asks of the frame loop besides the edit it did.
+struct ScriptEffect {
+  bool wait_for_planner = false;     ///< Hold the script until the planner ends.
+  std::filesystem::path screenshot;  ///< Save the window to this file at the next frame.
+};
+
+/// Runs one line against `app`; relative paths resolve against `base_dir`. A refused edit fails
+/// with its reason (kInvalidInput), prefixed by the line number.
+Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line,
+                                   const std::filesystem::path& base_dir);
+
+}  // namespace wrap::gui

@@ -1,0 +1,177 @@
+#include "gui/viewport_renderer.h"
+
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+
+#include "robot/robot_check.h"
+#include "sim/mjcf.h"
+#include "sim/mujoco_model.h"
+
+namespace wrap::gui {
+
+namespace {
+constexpr int kExtraGeoms = 64;  // arrows and markers added after mjv_updateScene
+}
+
+struct ViewportRenderer::Impl {
+  ProjectCheck check;
+  CellScene scene;
+  std::unique_ptr<CellModel> model;
+  std::unique_ptr<mjData, void (*)(mjData*)> data{nullptr, mj_deleteData};
+  std::vector<int> part_body;  // body id per part
+  mjvScene mjscene;
+  mjvOption option;
+  mjvCamera camera;
+  mjrContext context;
+  bool scene_made = false;
+  bool context_made = false;
+  int last_w = 1, last_h = 1;
+
+  ~Impl() { Free(); }
+  void Free() {
+    if (context_made) mjr_freeContext(&context);
+    if (scene_made) mjv_freeScene(&mjscene);
+    context_made = scene_made = false;
+  }
+};
+
+ViewportRenderer::ViewportRenderer() = default;
+ViewportRenderer::~ViewportRenderer() = default;
+
+bool ViewportRenderer::ready() const { return impl_ && impl_->model; }
+const CellScene& ViewportRenderer::scene() const { return impl_->scene; }
+const ProjectCheck& ViewportRenderer::check() const { return impl_->check; }
+
+Result<void> ViewportRenderer::Build(const Project& project, const std::filesystem::path& file) {
+  InstallMujocoHandlers();
+  auto next = std::make_unique<Impl>();
+  next->check = ValidateProject(project, file);
+  auto scene = BuildCellScene(project, next->check, file);
+  if (!scene) return std::unexpected(scene.error());
+  next->scene = std::move(*scene);
+  const SceneState state = InitialState(next->scene);
+  MjcfOptions options;
+  options.shadows = true;
+  options.shadow_map_px = 1024;  // software GL: keep the frame rate up
+  auto doc = BuildCellMjcf(next->scene, state, options);
+  if (!doc) return std::unexpected(doc.error());
+  auto compiled = CellModel::Compile(*doc);
+  if (!compiled) return std::unexpected(compiled.error());
+  next->model = std::make_unique<CellModel>(std::move(*compiled));
+  const mjModel* m = next->model->model();
+  for (const std::string& body : doc->part_bodies) {
+    next->part_body.push_back(mj_name2id(m, mjOBJ_BODY, body.c_str()));
+  }
+  Impl* n = next.get();
+  auto made = RunGuarded("making the viewport's GL context", [&] {
+    n->data = next->model->MakeData();
+    mjv_defaultOption(&n->option);
+    mjv_defaultScene(&n->mjscene);
+    mjv_makeScene(m, &n->mjscene, m->ngeom + kExtraGeoms);
+    n->scene_made = true;
+    mjr_defaultContext(&n->context);
+    mjr_makeContext(m, &n->context, mjFONTSCALE_100);
+    n->context_made = true;
+    mjr_setBuffer(mjFB_WINDOW, &n->context);
+    mjv_defaultFreeCamera(m, &n->camera);
+  });
+  if (!made) return made;
+  if (!n->data) return Fail(ErrorCode::kInternal, "MuJoCo could not allocate its data");
+  n->mjscene.flags[mjRND_SHADOW] = 1;
+  n->mjscene.flags[mjRND_REFLECTION] = 0;
+  n->mjscene.flags[mjRND_SKYBOX] = 1;
+  if (auto applied = n->model->Apply(state, n->data.get()); !applied) return applied;
+  // Keep the camera the user had when the cell is rebuilt after an edit.
+  const bool keep_camera = ready();
+  const mjvCamera old_camera = keep_camera ? impl_->camera : n->camera;
+  impl_ = std::move(next);
+  if (keep_camera) {
+    impl_->camera = old_camera;
+  } else {
+    ResetCamera();
+  }
+  return {};
+}
+
+Result<void> ViewportRenderer::SetState(const SceneState& state) {
+  if (!ready()) return Fail(ErrorCode::kInternal, "viewport: no cell");
+  return impl_->model->Apply(state, impl_->data.get());
+}
+
+void ViewportRenderer::ResetCamera() {
+  if (!ready()) return;
+  const CameraView view =
+      FrameBox(SceneBounds(impl_->scene, InitialState(impl_->scene)), 105.0, -35.0, 40.0, 1.4, 1.0);
+  impl_->camera.type = mjCAMERA_FREE;
+  for (int i = 0; i < 3; ++i) impl_->camera.lookat[i] = view.lookat[i];
+  impl_->camera.azimuth = view.azimuth_deg;
+  impl_->camera.elevation = view.elevation_deg;
+  impl_->camera.distance = view.distance_m;
+}
+
+void ViewportRenderer::Orbit(double dx, double dy) {
+  if (!ready()) return;
+  mjv_moveCamera(impl_->model->model(), mjMOUSE_ROTATE_V, dx, dy, &impl_->mjscene, &impl_->camera);
+}
+
+void ViewportRenderer::Pan(double dx, double dy) {
+  if (!ready()) return;
+  mjv_moveCamera(impl_->model->model(), mjMOUSE_MOVE_V, dx, dy, &impl_->mjscene, &impl_->camera);
+}
+
+void ViewportRenderer::Zoom(double d) {
+  if (!ready()) return;
+  mjv_moveCamera(impl_->model->model(), mjMOUSE_ZOOM, 0.0, d, &impl_->mjscene, &impl_->camera);
+}
+
+void ViewportRenderer::Draw(int x, int y, int width, int height) {
+  if (!ready() || width <= 0 || height <= 0) return;
+  Impl& s = *impl_;
+  s.last_w = width;
+  s.last_h = height;
+  const mjModel* m = s.model->model();
+  (void)RunGuarded("drawing the viewport", [&] {
+    mjv_updateScene(m, s.data.get(), &s.option, nullptr, &s.camera, mjCAT_ALL, &s.mjscene);
+    // Highlight the selected part: every geom of its body glows.
+    if (selected_part_ >= 0 && selected_part_ < static_cast<int>(s.part_body.size())) {
+      const int body = s.part_body[selected_part_];
+      for (int g = 0; g < s.mjscene.ngeom; ++g) {
+        mjvGeom& geom = s.mjscene.geoms[g];
+        if (geom.objtype == mjOBJ_GEOM && geom.objid >= 0 && m->geom_bodyid[geom.objid] == body) {
+          geom.emission = 0.45f;
+        }
+      }
+    }
+    if (arrow_ && s.mjscene.ngeom < s.mjscene.maxgeom) {
+      mjvGeom* geom = s.mjscene.geoms + s.mjscene.ngeom;
+      const float rgba[4] = {static_cast<float>(arrow_->color[0]),
+                             static_cast<float>(arrow_->color[1]),
+                             static_cast<float>(arrow_->color[2]), 1.0f};
+      mjv_initGeom(geom, mjGEOM_ARROW, nullptr, nullptr, nullptr, rgba);
+      mjtNum from[3] = {arrow_->from_W.x(), arrow_->from_W.y(), arrow_->from_W.z()};
+      mjtNum to[3] = {arrow_->to_W.x(), arrow_->to_W.y(), arrow_->to_W.z()};
+      mjv_makeConnector(geom, mjGEOM_ARROW, 0.006, from[0], from[1], from[2], to[0], to[1], to[2]);
+      geom->category = mjCAT_DECOR;
+      s.mjscene.ngeom++;
+    }
+    mjr_setBuffer(mjFB_WINDOW, &s.context);
+    const mjrRect rect{x, y, width, height};
+    mjr_render(rect, &s.mjscene, &s.context);
+  });
+}
+
+int ViewportRenderer::Pick(double rel_x, double rel_y) const {
+  if (!ready()) return -1;
+  const Impl& s = *impl_;
+  mjtNum point[3];
+  int geom = -1, skin = -1;
+  const int body = mjv_select(s.model->model(), s.data.get(), &s.option,
+                              static_cast<mjtNum>(s.last_w) / std::max(1, s.last_h), rel_x, rel_y,
+                              &s.mjscene, point, &geom, &skin);
+  if (body < 0) return -1;
+  auto it = std::find(s.part_body.begin(), s.part_body.end(), body);
+  return it == s.part_body.end() ? -1 : static_cast<int>(it - s.part_body.begin());
+}
+
+}  // namespace wrap::gui

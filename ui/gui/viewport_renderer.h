@@ -1,0 +1,70 @@
+// The window's counterpart of ui/render's OffscreenRenderer: the cell compiled by the same MJCF
+// builder (sim/), drawn by MuJoCo's mjv/mjr into a rectangle of the GUI window's GL context
+// (mjFB_WINDOW), with a free camera the mouse moves and picking of parts. It runs on the GUI
+// thread, whose context must be current.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/result.h"
+#include "model/project.h"
+#include "model/validate.h"
+#include "sim/scene.h"
+
+namespace wrap::gui {
+
+/// An arrow drawn into the scene (e.g. the insertion axis of the selected step).
+struct SceneArrow {
+  Vec3 from_W = Vec3::Zero();  ///< Tail, world [m].
+  Vec3 to_W = Vec3::Zero();    ///< Head, world [m].
+  Rgba color = {0.95, 0.2, 0.15, 1.0};
+};
+
+/// The cell of the document, compiled and drawn in the viewport.
+class ViewportRenderer {
+ public:
+  ViewportRenderer();
+  ~ViewportRenderer();
+  ViewportRenderer(const ViewportRenderer&) = delete;
+  ViewportRenderer& operator=(const ViewportRenderer&) = delete;
+
+  /// Validates `project` (meshes loaded), builds its scene and MJCF, compiles it and makes
+  /// MuJoCo's GL resources. On failure the previous cell stays and the error says why.
+  Result<void> Build(const Project& project, const std::filesystem::path& project_file);
+  /// True once a cell is built.
+  bool ready() const;
+  /// The scene and DAG of the cell drawn (valid while ready()).
+  const CellScene& scene() const;
+  const ProjectCheck& check() const;
+
+  /// Shows `state` (robots, fingers, parts) from the next Draw on.
+  Result<void> SetState(const SceneState& state);
+  /// Draws into the window rectangle (x, y from the bottom-left, GL convention) [px].
+  void Draw(int x, int y, int width, int height);
+
+  /// Part under the point (rel_x, rel_y) in [0, 1] of the last drawn rectangle (origin
+  /// bottom-left), or -1.
+  int Pick(double rel_x, double rel_y) const;
+  /// Highlights a part (index into the scene's parts; -1: none).
+  void set_selected_part(int part) { selected_part_ = part; }
+  /// Draws an arrow (absent: none).
+  void set_arrow(std::optional<SceneArrow> arrow) { arrow_ = arrow; }
+
+  /// Mouse camera moves, in fractions of the viewport height.
+  void Orbit(double dx, double dy);
+  void Pan(double dx, double dy);
+  void Zoom(double d);
+  /// Frames the whole cell from the default direction.
+  void ResetCamera();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int selected_part_ = -1;
+  std::optional<SceneArrow> arrow_;
+};
+
+}  // namespace wrap::gui
