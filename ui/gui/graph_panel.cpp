@@ -14,7 +14,8 @@ namespace wrap::gui {
 
 namespace {
 
-constexpr float kNodeW = 130.0f, kNodeH = 26.0f, kColW = 170.0f, kRowH = 40.0f;
+constexpr float kNodeH = 26.0f, kRowH = 40.0f;
+float kNodeW = 130.0f;  // shrinks with the columns when the DAG is deep (AutoLayout)
 
 const Step* FindStep(const Project& p, const std::string& name) {
   for (const Step& s : p.steps) {
@@ -25,8 +26,19 @@ const Step* FindStep(const Project& p, const std::string& name) {
 
 }  // namespace
 
+std::string GraphPanel::Signature(const Project& project) {
+  std::string sig;
+  for (const Part& part : project.parts) sig += part.name + ";";
+  for (const Step& step : project.steps) {
+    sig += "|" + step.name + ":";
+    for (const std::string& in : step.inputs) sig += in + ",";
+  }
+  return sig;
+}
+
 void GraphPanel::AutoLayout(const Project& project) {
   pos.clear();
+  signature = Signature(project);
   std::map<std::string, int> column;
   std::function<int(const std::string&, int)> depth = [&](const std::string& n, int guard) {
     if (auto it = column.find(n); it != column.end()) return it->second;
@@ -39,6 +51,13 @@ void GraphPanel::AutoLayout(const Project& project) {
     column[n] = d;
     return d;
   };
+  int deepest = 0;
+  for (const Step& step : project.steps) deepest = std::max(deepest, depth(step.name, 0));
+  // Columns fit the canvas width; nodes narrow with them.
+  const float col_w =
+      std::clamp((canvas_width - 150.0f) / static_cast<float>(std::max(1, deepest)), 70.0f, 170.0f);
+  kNodeW = std::min(130.0f, col_w - 14.0f);
+  const float kColW = col_w;
   std::map<int, int> rows;
   // Steps first in DAG order, so that inputs sit near their step; parts in file order.
   for (const Part& part : project.parts) {
@@ -70,7 +89,8 @@ void GraphPanel::Draw(AppState& app, const PanelRect& r) {
   bool unplaced = false;
   for (const Part& part : p.parts) unplaced |= !pos.count(part.name);
   for (const Step& step : p.steps) unplaced |= !pos.count(step.name);
-  if (unplaced) AutoLayout(p);
+  canvas_width = std::max(200.0f, ImGui::GetContentRegionAvail().x);
+  if (unplaced || Signature(p) != signature) AutoLayout(p);
 
   ImGui::SetNextItemWidth(110);
   ImGui::InputText("##newstep", &new_step_name);
@@ -172,7 +192,9 @@ void GraphPanel::Draw(AppState& app, const PanelRect& r) {
     dl->AddRect(b, ImVec2(b.x + kNodeW, b.y + kNodeH),
                 selected ? IM_COL32(255, 220, 90, 255) : IM_COL32(110, 115, 125, 255), 4.0f, 0,
                 selected ? 2.5f : 1.0f);
-    dl->AddText(ImVec2(b.x + 10, b.y + 5), IM_COL32(230, 230, 230, 255), n.c_str());
+    const ImVec4 clip(b.x, b.y, b.x + kNodeW - 6, b.y + kNodeH);
+    dl->AddText(nullptr, 0.0f, ImVec2(b.x + 10, b.y + 5), IM_COL32(230, 230, 230, 255), n.c_str(),
+                nullptr, 0.0f, &clip);
     dl->AddCircleFilled(port(n), 4.5f, IM_COL32(200, 200, 90, 255));
     if (is_step) dl->AddCircleFilled(in_port(n), 3.5f, IM_COL32(150, 170, 200, 255));
     if (inside(n, mouse)) node_under_mouse = n;

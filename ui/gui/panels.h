@@ -33,15 +33,19 @@ struct PartsPanel {
 /// The assembly DAG as a node canvas: parts and steps, drag from a node's port onto a step to
 /// make an input, right-click an edge to remove it, automatic layout.
 struct GraphPanel {
-  std::map<std::string, ImVec2> pos;     ///< Node positions on the canvas (canvas units).
-  unsigned long layout_revision = ~0ul;  ///< Revision the layout was made for.
-  std::string drag_from;                 ///< Node a link is dragged from ("" none).
-  std::string moving;                    ///< Node being moved.
-  std::string new_step_name = "step";    ///< Name field of "New step".
-  std::string rename_to;                 ///< Rename field.
-  ImVec2 scroll{20, 20};                 ///< Canvas offset [px].
-  /// Places every node: parts in column 0, each step one column right of its deepest input.
+  std::map<std::string, ImVec2> pos;   ///< Node positions on the canvas (canvas units).
+  std::string drag_from;               ///< Node a link is dragged from ("" none).
+  std::string moving;                  ///< Node being moved.
+  std::string new_step_name = "step";  ///< Name field of "New step".
+  std::string rename_to;               ///< Rename field.
+  ImVec2 scroll{20, 20};               ///< Canvas offset [px].
+  std::string signature;               ///< Nodes and edges the layout was made for.
+  float canvas_width = 400.0f;         ///< Width of the canvas last drawn [px].
+  /// Places every node: parts in column 0, each step one column right of its deepest input,
+  /// the columns fitted to the canvas width.
   void AutoLayout(const Project& project);
+  /// The nodes and edges of `project` as a string: the layout is redone when it changes.
+  static std::string Signature(const Project& project);
   void Draw(AppState& app, const PanelRect& r);
 };
 

@@ -83,11 +83,14 @@ Result<void> SetField(AppState& app, const ScriptLine& line) {
       if (field == "mass_kg") part.mass_kg = *v;
       if (field == "density_kg_m3") part.density_kg_m3 = *v;
       if (field == "scale") part.scale = *v;
-    } else if (field == "initial_xyz" || field == "initial_rpy_deg" || field == "color") {
+    } else if (field == "initial_xyz" || field == "initial_rpy_deg" || field == "color" ||
+               field == "assembled_xyz" || field == "assembled_rpy_deg") {
       auto v = Vector(line, 2);
       if (!v) return std::unexpected(v.error());
       if (field == "initial_xyz") part.initial_pose.xyz = *v;
       if (field == "initial_rpy_deg") part.initial_pose.rpy = *v * kDeg;
+      if (field == "assembled_xyz") part.assembled_pose.xyz = *v;
+      if (field == "assembled_rpy_deg") part.assembled_pose.rpy = *v * kDeg;
       if (field == "color") part.color = {v->x(), v->y(), v->z(), 1.0};
     } else {
       return unknown();

@@ -6,7 +6,12 @@
 //   add-step NAME | delete-step NAME | rename OLD NEW
 //   add-edge INPUT STEP | remove-edge INPUT STEP     inputs of a step (cycles are refused)
 //   add-robot MODEL END_EFFECTOR | remove-robot NAME
-//   set FIELD VALUE...                 a field, e.g. `set part.seat.mass_kg 0.2`,
+//   set FIELD VALUE...                 a field, e.g. `set part.seat.mass_kg 0.2` (part: mass_kg,
+//                                      density_kg_m3, scale, color, initial_xyz, initial_rpy_deg,
+//                                      assembled_xyz, assembled_rpy_deg; mating: moved, base,
+//                                      axis, force_N, torque_Nm, transverse_fraction, offset_m,
+//                                      approach_m; robot: end_effector, base_xyz, base_rpy_deg;
+//                                      table.height|friction; planner.time_limit_s|seed|grasps),
 //                                      `set mating.s1.axis 0 0 1`, `set robot.r1.base_xyz 0 0 .75`
 //   undo | redo
 //   option NAME VALUE                  planner option: planner, wrench, time_limit_s, seed,

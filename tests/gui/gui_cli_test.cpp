@@ -1,0 +1,234 @@
+// The GUI as a process under Xvfb: `wrap PROJECT --screenshot` (with --run-plan and --at) and a
+// scripted flow that builds a project from meshes, draws its DAG, plans and saves it. Screenshots
+// are checked by pixel statistics per region of the fixed layout (panels present, scene drawn),
+// not against golden images: fonts and llvmpipe versions move pixels. Skipped without xvfb-run.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "gui/document.h"
+#include "gui_fixture.h"
+#include "render/image.h"
+
+namespace wrap::gui {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ExampleProject;
+using testing::ScratchDir;
+
+bool HaveXvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+
+struct ProcessRun {
+  int code = -1;
+  std::string output;
+};
+
+/// Runs `wrap ARGS` under xvfb-run in `dir`, capturing stdout and stderr.
+ProcessRun WrapUnderXvfb(const fs::path& dir, const std::string& args, bool xvfb = true) {
+  const fs::path log = dir / "wrap.log";
+  const std::string cmd = "cd '" + dir.string() + "' && " +
+                          (xvfb ? std::string("xvfb-run -a -s '-screen 0 1600x1000x24' ")
+                                : std::string("env -u DISPLAY ")) +
+                          "'" + WRAP_EXE + "' " + args + " > '" + log.string() + "' 2>&1";
+  ProcessRun r;
+  const int status = std::system(cmd.c_str());
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(log);
+  std::stringstream s;
+  s << in.rdbuf();
+  r.output = s.str();
+  return r;
+}
+
+/// Statistics of a rectangle of an image.
+struct RegionStats {
+  double mean_luminance = 0;   ///< [0, 255].
+  double bright_fraction = 0;  ///< Pixels with luminance > 150.
+  int colours = 0;             ///< Distinct colours (quantised to 4 bits per channel).
+  long near_colour = 0;        ///< Pixels within 40 levels of a given colour.
+};
+
+RegionStats Stats(const render::Image& im, int x0, int y0, int x1, int y1,
+                  std::array<int, 3> colour = {-1000, 0, 0}) {
+  RegionStats s;
+  std::vector<bool> seen(4096, false);
+  long n = 0, bright = 0;
+  double sum = 0;
+  for (int y = y0; y < y1; ++y) {
+    for (int x = x0; x < x1; ++x) {
+      const std::uint8_t* p = im.at(x, y);
+      const double l = 0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2];
+      sum += l;
+      bright += l > 150;
+      ++n;
+      seen[(p[0] >> 4) << 8 | (p[1] >> 4) << 4 | (p[2] >> 4)] = true;
+      if (std::abs(p[0] - colour[0]) < 40 && std::abs(p[1] - colour[1]) < 40 &&
+          std::abs(p[2] - colour[2]) < 40) {
+        ++s.near_colour;
+      }
+    }
+  }
+  s.mean_luminance = sum / std::max(1L, n);
+  s.bright_fraction = static_cast<double>(bright) / std::max(1L, n);
+  s.colours = static_cast<int>(std::count(seen.begin(), seen.end(), true));
+  return s;
+}
+
+// The layout at 1400x900 (ui/gui/app.cpp): left column 23 % (parts, robots), right 27 % (graph,
+// mating, planner), centre: viewport over the top two thirds, the plan panel below.
+constexpr int kW = 1400, kH = 900;
+
+/// A dark ImGui panel with text in it.
+void ExpectPanel(const render::Image& im, int x0, int y0, int x1, int y1, const char* what) {
+  const RegionStats s = Stats(im, x0, y0, x1, y1);
+  EXPECT_LT(s.mean_luminance, 90) << what << ": a dark panel";
+  EXPECT_GT(s.bright_fraction, 0.003) << what << ": text drawn";
+  EXPECT_LT(s.bright_fraction, 0.4) << what;
+}
+
+TEST(GuiCli, ScreenshotOfTheStoolAfterPlanningAndScrubbing) {
+  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  const auto dir = ScratchDir("gui_cli_stool");
+  const ProcessRun r = WrapUnderXvfb(dir, "'" + ExampleProject("stool").string() +
+                                              "' --run-plan --at 40 --screenshot shot.png --size " +
+                                              std::to_string(kW) + "x" + std::to_string(kH));
+  ASSERT_EQ(r.code, 0) << r.output;
+  auto im = render::ReadPng(dir / "shot.png");
+  ASSERT_TRUE(im) << im.error().message;
+  ASSERT_EQ(im->width, kW);
+  ASSERT_EQ(im->height, kH);
+  ExpectPanel(*im, 5, 60, 310, 520, "parts panel");
+  ExpectPanel(*im, 5, 580, 310, 860, "robots panel");
+  ExpectPanel(*im, 1030, 60, 1395, 340, "assembly graph");
+  ExpectPanel(*im, 1030, 640, 1395, 860, "planner panel");
+  // The scene: light (sky, table), many colours (robots, parts, shadows), the seat's orange.
+  const RegionStats scene = Stats(*im, 340, 60, 1010, 560, {242, 142, 43});
+  EXPECT_GT(scene.mean_luminance, 120);
+  EXPECT_GT(scene.colours, 60) << "robots, parts, table, shadows: many colours";
+  EXPECT_GT(scene.near_colour, 200) << "the orange seat is in view";
+  // The plan panel: lanes with assemble bars (orange) after --run-plan.
+  const RegionStats plan = Stats(*im, 330, 600, 1010, 880, {230, 140, 50});
+  EXPECT_GT(plan.near_colour, 100) << "assemble bars on the robots' lanes";
+}
+
+TEST(GuiCli, ScriptBuildsAProjectFromMeshesPlansAndSavesIt) {
+  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  const auto dir = ScratchDir("gui_cli_script");
+  // The stool's cell (table, robots) without parts or steps.
+  {
+    auto doc = Document::Open(ExampleProject("stool"));
+    ASSERT_TRUE(doc);
+    Project empty = doc->project();
+    empty.parts.clear();
+    empty.steps.clear();
+    empty.name = "built";
+    Document blank(empty, {});
+    ASSERT_TRUE(blank.SaveAs(dir / "empty.json"));
+  }
+  const fs::path meshes = fs::path(WRAP_SOURCE_DIR) / "assets/parts/stool";
+  std::ofstream(dir / "flow.wrapscript") << "# a half stool from meshes\n"
+                                         << "import " << (meshes / "seat.stl").string() << " mm\n"
+                                         << "import " << (meshes / "leg.stl").string() << " mm\n"
+                                         << "rename leg leg1\n"
+                                         << "import " << (meshes / "leg.stl").string() << " mm\n"
+                                         << "rename leg leg2\n"
+                                         << "set part.seat.assembled_xyz 0 0 0.185\n"
+                                         << "set part.leg1.assembled_xyz 0.085 0.085 0\n"
+                                         << "set part.leg2.assembled_xyz -0.085 0.085 0\n"
+                                         << "set part.seat.initial_xyz -0.2 0 0.75\n"
+                                         << "set part.leg1.initial_xyz 0.16 0.16 0.75\n"
+                                         << "set part.leg2.initial_xyz 0.16 0.05 0.75\n"
+                                         << "add-step seat+leg1\n"
+                                         << "add-edge seat seat+leg1\n"
+                                         << "add-edge leg1 seat+leg1\n"
+                                         << "add-step half\n"
+                                         << "add-edge seat+leg1 half\n"
+                                         << "add-edge leg2 half\n"
+                                         << "expect-refused add-edge half seat+leg1\n"
+                                         << "set mating.half.force_N 12\n"
+                                         << "select step half\n"
+                                         << "option task_only 1\n"
+                                         << "run\n"
+                                         << "wait\n"
+                                         << "expect-plan\n"
+                                         << "scrub 3\n"
+                                         << "save built.json\n"
+                                         << "screenshot built.png\n";
+  const ProcessRun r = WrapUnderXvfb(dir, "empty.json --script flow.wrapscript --size 1400x900");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("ok 19: expect-refused"), std::string::npos) << r.output;
+
+  // Reload the saved file and compare with what the script built.
+  auto built = Document::Open(dir / "built.json");
+  ASSERT_TRUE(built) << built.error().message;
+  const Project& p = built->project();
+  ASSERT_EQ(p.parts.size(), 3u);
+  EXPECT_EQ(p.parts[0].name, "seat");
+  EXPECT_EQ(p.parts[1].name, "leg1");
+  EXPECT_EQ(p.parts[2].name, "leg2");
+  EXPECT_DOUBLE_EQ(p.parts[0].scale, 0.001);
+  EXPECT_EQ(p.parts[1].assembled_pose.xyz, Vec3(0.085, 0.085, 0));
+  EXPECT_EQ(p.parts[2].initial_pose.xyz, Vec3(0.16, 0.05, 0.75));
+  for (const Part& part : p.parts) {
+    EXPECT_TRUE(fs::exists(dir / part.mesh)) << part.mesh << " relative to the saved file";
+  }
+  ASSERT_EQ(p.steps.size(), 2u);
+  EXPECT_EQ(p.steps[0].inputs, (std::vector<std::string>{"seat", "leg1"}));
+  EXPECT_EQ(p.steps[1].inputs, (std::vector<std::string>{"seat+leg1", "leg2"}));
+  EXPECT_EQ(p.steps[1].mating.base, "seat+leg1");
+  EXPECT_EQ(p.steps[1].mating.moved, "leg2");
+  EXPECT_DOUBLE_EQ(p.steps[1].mating.force_N, 12);
+  EXPECT_EQ(p.robots.size(), 4u);
+
+  auto im = render::ReadPng(dir / "built.png");
+  ASSERT_TRUE(im) << im.error().message;
+  const RegionStats scene = Stats(*im, 340, 60, 1010, 560);
+  EXPECT_GT(scene.colours, 60) << "robots, parts, table, shadows: many colours";
+  const RegionStats plan = Stats(*im, 330, 600, 1010, 880, {230, 140, 50});
+  EXPECT_GT(plan.near_colour, 100) << "the plan's lanes";
+}
+
+TEST(GuiCli, BadScriptIsBadInputNamingTheLine) {
+  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  const auto dir = ScratchDir("gui_cli_bad_script");
+  std::ofstream(dir / "bad.wrapscript") << "undo\nteleport seat\n";
+  const ProcessRun r =
+      WrapUnderXvfb(dir, "'" + ExampleProject("stool").string() + "' --script bad.wrapscript");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("line 2"), std::string::npos) << r.output;
+}
+
+TEST(GuiCli, AFailingScriptLineExitsOne) {
+  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  const auto dir = ScratchDir("gui_cli_failing_script");
+  std::ofstream(dir / "f.wrapscript") << "add-edge stool seat+leg1\n";
+  const ProcessRun r =
+      WrapUnderXvfb(dir, "'" + ExampleProject("stool").string() + "' --script f.wrapscript");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("two inputs"), std::string::npos) << r.output;
+}
+
+TEST(GuiCli, NoDisplayIsBadInputWithAHint) {
+  const auto dir = ScratchDir("gui_cli_no_display");
+  const ProcessRun r =
+      WrapUnderXvfb(dir, "'" + ExampleProject("stool").string() + "' --screenshot x.png",
+                    /*xvfb=*/false);
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("DISPLAY"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "x.png"));
+}
+
+TEST(GuiCli, MissingProjectIsBadInput) {
+  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  const auto dir = ScratchDir("gui_cli_missing");
+  const ProcessRun r = WrapUnderXvfb(dir, "nope.json --screenshot x.png");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("nope.json"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace wrap::gui
