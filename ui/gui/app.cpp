@@ -421,7 +421,16 @@ class App {
         }
       }
     }
-    return InitialState(scene);
+    // Initial poses as the document has them now (a drag or a typed pose shows before the
+    // cell is rebuilt).
+    SceneState state = InitialState(scene);
+    const Project& p = s_.doc.project();
+    for (size_t i = 0; i < scene.parts.size(); ++i) {
+      for (const Part& part : p.parts) {
+        if (part.name == scene.parts[i].name) state.X_WP[i] = ToIsometry(part.initial_pose);
+      }
+    }
+    return state;
   }
 
   /// The insertion axis of the selected step, drawn at its moved input's first part where it

@@ -257,6 +257,10 @@ void GraphPanel::Draw(AppState& app, const PanelRect& r) {
     scroll.y += ImGui::GetIO().MouseDelta.y;
   }
   dl->PopClipRect();
+  if (hovered && hovered_edge_step.empty() && !node_under_mouse.empty() && drag_from.empty()) {
+    ImGui::SetTooltip("%s (drag its right port onto a step to make it an input)",
+                      node_under_mouse.c_str());
+  }
   if (!hovered_edge_step.empty()) {
     ImGui::SetTooltip("'%s' -> '%s' (right-click: remove)", hovered_edge_input.c_str(),
                       hovered_edge_step.c_str());

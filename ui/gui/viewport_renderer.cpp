@@ -110,6 +110,17 @@ void ViewportRenderer::ResetCamera() {
   impl_->camera.distance = view.distance_m;
 }
 
+CameraView ViewportRenderer::camera() const {
+  CameraView view;
+  if (!ready()) return view;
+  const mjvCamera& c = impl_->camera;
+  view.lookat = Vec3(c.lookat[0], c.lookat[1], c.lookat[2]);
+  view.azimuth_deg = c.azimuth;
+  view.elevation_deg = c.elevation;
+  view.distance_m = c.distance;
+  return view;
+}
+
 void ViewportRenderer::Orbit(double dx, double dy) {
   if (!ready()) return;
   mjv_moveCamera(impl_->model->model(), mjMOUSE_ROTATE_V, dx, dy, &impl_->mjscene, &impl_->camera);

@@ -12,6 +12,7 @@
 #include "core/result.h"
 #include "model/project.h"
 #include "model/validate.h"
+#include "sim/mjcf.h"
 #include "sim/scene.h"
 
 namespace wrap::gui {
@@ -59,6 +60,8 @@ class ViewportRenderer {
   void Zoom(double d);
   /// Frames the whole cell from the default direction.
   void ResetCamera();
+  /// The camera as it stands (azimuth, elevation [deg], distance [m], look-at point).
+  CameraView camera() const;
 
  private:
   struct Impl;
