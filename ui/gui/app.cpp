@@ -449,10 +449,21 @@ class App {
     if (part >= static_cast<int>(scene.parts.size()) || step->mating.axis.norm() < 1e-9) {
       return std::nullopt;
     }
-    const Iso3 X_WA = scene.parts[part].X_WP_initial * scene.parts[part].X_AP.inverse();
+    // From the middle of the part (where it is now) along the direction it travels, out past
+    // its far side.
+    const ScenePart& sp = scene.parts[part];
+    Iso3 X_WP = sp.X_WP_initial;
+    for (const Part& q : p.parts) {
+      if (q.name == sp.name) X_WP = ToIsometry(q.initial_pose);
+    }
+    const Iso3 X_WA = X_WP * sp.X_AP.inverse();
     const Vec3 axis_W = X_WA.linear() * step->mating.axis.normalized();
-    const Vec3 at = scene.parts[part].X_WP_initial.translation() + Vec3(0, 0, 0.02);
-    return SceneArrow{at - 0.15 * axis_W, at, {0.95, 0.2, 0.15, 1.0}};
+    const Aabb box = sp.mesh ? ComputeAabb(*sp.mesh) : Aabb{};
+    const Vec3 centre_W = X_WP * (0.5 * (box.min + box.max));
+    const Vec3 axis_P = X_WP.linear().transpose() * axis_W;
+    const double half = 0.5 * axis_P.cwiseAbs().dot(box.size());  // centre to the far side
+    const Vec3 tail = centre_W + (half + 0.01) * axis_W;
+    return SceneArrow{tail, tail + 0.15 * axis_W, {0.95, 0.2, 0.15, 1.0}};
   }
 
   void LoadRecent() {

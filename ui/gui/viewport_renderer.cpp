@@ -150,7 +150,10 @@ void ViewportRenderer::Draw(int x, int y, int width, int height) {
       for (int g = 0; g < s.mjscene.ngeom; ++g) {
         mjvGeom& geom = s.mjscene.geoms[g];
         if (geom.objtype == mjOBJ_GEOM && geom.objid >= 0 && m->geom_bodyid[geom.objid] == body) {
-          geom.emission = 0.45f;
+          // Towards amber, and glowing: visible on any part colour.
+          const float amber[3] = {1.0f, 0.78f, 0.15f};
+          for (int c = 0; c < 3; ++c) geom.rgba[c] = 0.4f * geom.rgba[c] + 0.6f * amber[c];
+          geom.emission = 0.35f;
         }
       }
     }
@@ -162,7 +165,7 @@ void ViewportRenderer::Draw(int x, int y, int width, int height) {
       mjv_initGeom(geom, mjGEOM_ARROW, nullptr, nullptr, nullptr, rgba);
       mjtNum from[3] = {arrow_->from_W.x(), arrow_->from_W.y(), arrow_->from_W.z()};
       mjtNum to[3] = {arrow_->to_W.x(), arrow_->to_W.y(), arrow_->to_W.z()};
-      mjv_makeConnector(geom, mjGEOM_ARROW, 0.006, from[0], from[1], from[2], to[0], to[1], to[2]);
+      mjv_makeConnector(geom, mjGEOM_ARROW, 0.012, from[0], from[1], from[2], to[0], to[1], to[2]);
       geom->category = mjCAT_DECOR;
       s.mjscene.ngeom++;
     }
