@@ -110,6 +110,19 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
                  "Stop after the task plan: no keyframe optimisation, motion planning or "
                  "retiming");
 
+  SimArgs sim_args;
+  CLI::App* sim = app.add_subcommand(
+      "sim", "Run a plan in MuJoCo: does it hold, gripper utilisation, failure (paper V-B)");
+  sim->add_option("PROJECT", sim_args.project, "Project file (.json)")->required();
+  sim->add_option("--plan", sim_args.plan, "Plan file with motion (.json)")->required();
+  sim->add_option("-o,--output", sim_args.output, "Write the report JSON to this file (atomic)");
+  sim->add_option("--video", sim_args.video, "Record the run as an MP4 (not implemented yet)");
+  sim->add_option("--force-scale", sim_args.force_scale,
+                  "Scale lambda on the applied mating wrench (default 1)")
+      ->check(CLI::NonNegativeNumber);
+  sim->add_option("--mjcf", sim_args.mjcf_dir,
+                  "Also write the physics model (cell.xml + meshes) to this folder");
+
   // No subcommand: the GUI, optionally on a project, with its headless hooks.
   GuiArgs gui;
   double gui_at = 0.0;
@@ -140,6 +153,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     return Preprocess(pre, out, err);
   }
   if (render->parsed()) return Render(ren, out, err);
+  if (sim->parsed()) return Sim(sim_args, out, err);
   if (plan->parsed()) {
     if (plan_seed_option->count() > 0) plan_args.seed = plan_seed;
     if (plan_time_option->count() > 0) plan_args.time_limit = plan_time_limit;

@@ -91,6 +91,21 @@ struct RenderArgs {
 /// unavailable, invalid project, a plan that is malformed or for another project), 3 internal.
 int Render(const RenderArgs& args, std::ostream& out, std::ostream& err);
 
+/// Arguments of `wrap sim`.
+struct SimArgs {
+  std::string project;       ///< Project file.
+  std::string plan;          ///< --plan PLAN.json (with motion).
+  std::string output;        ///< -o REPORT.json (atomic); empty: not written.
+  std::string video;         ///< --video FILE.mp4 (not implemented yet: exit 2).
+  double force_scale = 1.0;  ///< --force-scale lambda on the applied mating wrench.
+  std::string mjcf_dir;      ///< --mjcf DIR: also write the physics model there.
+};
+
+/// `wrap sim PROJECT --plan PLAN [-o REPORT.json]`: runs the plan in MuJoCo (paper V-B) and
+/// reports whether it holds, the grippers' peak utilisations and the failure; exit 0 holds,
+/// 1 fails, 2 bad input, 3 internal (a MuJoCo error).
+int Sim(const SimArgs& args, std::ostream& out, std::ostream& err);
+
 /// Arguments of the GUI (`wrap` without a subcommand).
 struct GuiArgs {
   std::string project;       ///< PROJECT to open; empty: a new project.

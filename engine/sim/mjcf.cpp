@@ -1,5 +1,6 @@
 #include "sim/mjcf.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -9,6 +10,7 @@
 #include <utility>
 
 #include "core/file_io.h"
+#include "robot/kinematics.h"
 
 namespace wrap {
 
@@ -105,6 +107,16 @@ class Writer {
     Line("<mujoco model=\"" + Esc(scene_.name.empty() ? "cell" : scene_.name) + "\">");
     ++depth_;
     Line("<compiler angle=\"radian\" inertiafromgeom=\"false\"/>");
+    if (options_.physics) {
+      // Dense Jacobians: verify/ reads the weld rows of efc_J to measure gripper wrenches.
+      // Multi-point convex collision: with one contact per mesh-box pair a flat part rocks
+      // and tips over the table's edge instead of resting on its face.
+      Line("<option timestep=\"" + Num(options_.timestep_s) +
+           "\" gravity=\"0 0 -9.81\" jacobian=\"dense\">");
+      Line("  <flag multiccd=\"enable\"/>");
+      Line("</option>");
+      Line("<size njmax=\"6000\" nconmax=\"1500\"/>");
+    }
     Line("<statistic center=\"" + Vec(center) + "\" extent=\"" + Num(extent) + "\"/>");
     Visual();
     Defaults();
@@ -128,9 +140,14 @@ class Writer {
       if (auto ok = RobotBodies(static_cast<int>(r)); !ok) return std::unexpected(ok.error());
     }
     for (size_t p = 0; p < scene_.parts.size(); ++p) PartBody(static_cast<int>(p));
+    if (options_.physics) TcpBodies();
     --depth_;
     Line("</worldbody>");
-    Keyframe();
+    if (options_.physics) {
+      Welds();
+    } else {
+      Keyframe();
+    }
     --depth_;
     Line("</mujoco>");
     for (auto& [mesh, name] : part_mesh_names_) {
@@ -271,7 +288,8 @@ class Writer {
   }
 
   void Floor() {
-    Line("<geom name=\"floor\" type=\"plane\" size=\"0 0 0.05\" material=\"floor\"/>");
+    Line("<geom name=\"floor\" type=\"plane\" size=\"0 0 0.05\" material=\"floor\"" +
+         SupportContact() + "/>");
   }
 
   void Table() {
@@ -281,7 +299,7 @@ class Writer {
     Line("<body name=\"table\">");
     ++depth_;
     Line("<geom name=\"table/top\" type=\"box\" pos=\"" + Vec(top_center) + "\" size=\"" +
-         Vec(half) + "\" material=\"table\"/>");
+         Vec(half) + "\" material=\"table\"" + SupportContact() + "/>");
     // Four legs from the floor to the underside, inset from the corners.
     const double underside = t.top_center.z() - t.size.z();
     const double leg = std::min({0.025, 0.1 * half.x(), 0.1 * half.y()});
@@ -467,6 +485,77 @@ class Writer {
     return {};
   }
 
+  // Physics: the table and floor collide with parts (contype 1 meets a part's conaffinity 1),
+  // parts not with each other (contype 2 meets only conaffinity 2).
+  std::string SupportContact() const {
+    if (!options_.physics) return "";
+    return " contype=\"1\" conaffinity=\"2\" friction=\"" + Num(scene_.table.friction) +
+           " 0.005 0.0001\"";
+  }
+  std::string PartContact() const {
+    if (!options_.physics) return "";
+    // Contacts as stiff as the step allows (a softer default lets heavy parts sink mm deep).
+    return " contype=\"2\" conaffinity=\"1\" friction=\"" + Num(scene_.table.friction) +
+           " 0.005 0.0001\" solref=\"" + Num(4.0 * options_.timestep_s) + " 1\"";
+  }
+
+  // Physics: a part's mass and inertia about its COM (a small box's when the mesh gives none).
+  void PartInertial(const ScenePart& part) {
+    const double mass = part.mass_kg > 0.0 ? part.mass_kg : 0.01;
+    Mat3 I = part.inertia_com;
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(0.5 * (I + I.transpose()));
+    if (!(eig.eigenvalues().minCoeff() > 1e-12)) {
+      const Vec3 size = ComputeAabb(*part.mesh).size().cwiseMax(Vec3::Constant(1e-3));
+      I = Mat3::Zero();
+      I(0, 0) = mass * (size.y() * size.y() + size.z() * size.z()) / 12.0;
+      I(1, 1) = mass * (size.x() * size.x() + size.z() * size.z()) / 12.0;
+      I(2, 2) = mass * (size.x() * size.x() + size.y() * size.y()) / 12.0;
+    }
+    Line("<inertial pos=\"" + Vec(part.com_P) + "\" mass=\"" + Num(mass) + "\" fullinertia=\"" +
+         Num(I(0, 0)) + " " + Num(I(1, 1)) + " " + Num(I(2, 2)) + " " + Num(I(0, 1)) + " " +
+         Num(I(0, 2)) + " " + Num(I(1, 2)) + "\"/>");
+  }
+
+  // Physics: one mocap body per robot at its TCP, which the simulation drives and welds to.
+  void TcpBodies() {
+    for (size_t r = 0; r < scene_.robots.size(); ++r) {
+      const SceneRobot& robot = scene_.robots[r];
+      const Iso3 X_WT = TcpPose(robot.chain, robot.X_WB, state_.q[r], robot.end_effector.X_FT);
+      const std::string name = "tcp:" + robot.name;
+      Line("<body name=\"" + Esc(name) + "\" mocap=\"true\"" + PoseAttrs(X_WT) + "/>");
+      doc_.tcp_bodies.push_back(name);
+    }
+  }
+
+  // Physics: inactive welds, TCP to part and part to part, stiff as the step allows (MuJoCo
+  // clamps the time constant to twice the step).
+  void Welds() {
+    const std::string solref = " solref=\"" + Num(2.0 * options_.timestep_s) + " 1\"";
+    const size_t np = scene_.parts.size();
+    Line("<equality>");
+    ++depth_;
+    doc_.grip_welds.assign(scene_.robots.size(), std::vector<std::string>(np));
+    for (size_t r = 0; r < scene_.robots.size(); ++r) {
+      for (size_t p = 0; p < np; ++p) {
+        const std::string name = "grip/" + std::to_string(r) + "/" + std::to_string(p);
+        Line("<weld name=\"" + name + "\" body1=\"" + Esc(doc_.tcp_bodies[r]) + "\" body2=\"" +
+             Esc(doc_.part_bodies[p]) + "\" active=\"false\"" + solref + "/>");
+        doc_.grip_welds[r][p] = name;
+      }
+    }
+    doc_.join_welds.assign(np, std::vector<std::string>(np));
+    for (size_t p = 0; p < np; ++p) {
+      for (size_t q = p + 1; q < np; ++q) {
+        const std::string name = "join/" + std::to_string(p) + "/" + std::to_string(q);
+        Line("<weld name=\"" + name + "\" body1=\"" + Esc(doc_.part_bodies[p]) + "\" body2=\"" +
+             Esc(doc_.part_bodies[q]) + "\" active=\"false\"" + solref + "/>");
+        doc_.join_welds[p][q] = name;
+      }
+    }
+    --depth_;
+    Line("</equality>");
+  }
+
   void Inertial() { Line("<inertial pos=\"0 0 0\" mass=\"0.1\" diaginertia=\"1e-4 1e-4 1e-4\"/>"); }
 
   // A part: a mocap body with its mesh (shared between parts made from one file), or the mesh's
@@ -474,10 +563,17 @@ class Writer {
   void PartBody(int p) {
     const ScenePart& part = scene_.parts[p];
     const std::string name = "part:" + part.name;
-    const std::string head =
-        "<geom name=\"" + Esc(name) + "\" material=\"" + Material(part.color, 0.3, 0.45) + "\"";
-    Line("<body name=\"" + Esc(name) + "\" mocap=\"true\"" + PoseAttrs(state_.X_WP[p]) + ">");
-    ++depth_;
+    const std::string head = "<geom name=\"" + Esc(name) + "\" material=\"" +
+                             Material(part.color, 0.3, 0.45) + "\"" + PartContact();
+    if (options_.physics) {
+      Line("<body name=\"" + Esc(name) + "\"" + PoseAttrs(state_.X_WP[p]) + ">");
+      ++depth_;
+      Line("<joint name=\"" + Esc(name) + "\" type=\"free\" damping=\"0\"/>");
+      PartInertial(part);
+    } else {
+      Line("<body name=\"" + Esc(name) + "\" mocap=\"true\"" + PoseAttrs(state_.X_WP[p]) + ">");
+      ++depth_;
+    }
     auto [accepted, fresh] = part_mesh_ok_.try_emplace(part.mesh.get(), false);
     if (fresh) accepted->second = MujocoAcceptsMesh(*part.mesh);
     if (accepted->second) {

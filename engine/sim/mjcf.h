@@ -62,6 +62,14 @@ struct MjcfOptions {
   int shadow_map_px = 2048;    ///< Side of the shadow map [px]: sharper shadows cost time on
                                ///< software GL (4096 is ~3x slower than 2048 on llvmpipe).
   SceneStyle style;            ///< Colours.
+  /// The physics variant (`wrap sim`, verify/): every part gets a free joint, its mass and
+  /// inertia, and contacts with the table and floor (not with other parts: MuJoCo collides
+  /// meshes as convex hulls, which would jam every peg in its hole); every robot gets a mocap
+  /// body "tcp:NAME" at its TCP; inactive weld constraints "grip/R/P" (TCP of robot R to part P)
+  /// and "join/P/Q" (part P to part Q, P < Q) are declared for a simulation to switch on and
+  /// off; no keyframe. Default false: the drawing model (visual geoms only, parts mocap).
+  bool physics = false;
+  double timestep_s = 0.001;  ///< Physics: integration step [s]; welds are as stiff as it allows.
 };
 
 /// A file the XML refers to: a mesh in MuJoCo's binary MSH format.
@@ -79,8 +87,14 @@ struct MjcfDocument {
   /// Per robot, the slide joints of the two fingers (qpos = half the opening); empty strings for
   /// a gripper without fingers.
   std::vector<std::array<std::string, 2>> finger_joints;
-  std::vector<std::string> part_bodies;  ///< Per part, the name of its mocap body.
-  std::vector<std::string> warnings;     ///< Shapes drawn approximately, e.g. a flat mesh.
+  std::vector<std::string> part_bodies;  ///< Per part, the name of its mocap body (physics:
+                                         ///< its free body).
+  std::vector<std::string> tcp_bodies;   ///< Physics: per robot its TCP mocap body; else empty.
+  /// Physics: grip_welds[r][p] names the weld of robot r's TCP to part p; else empty.
+  std::vector<std::vector<std::string>> grip_welds;
+  /// Physics: join_welds[p][q] (p < q) names the weld of part p to part q; else empty.
+  std::vector<std::vector<std::string>> join_welds;
+  std::vector<std::string> warnings;  ///< Shapes drawn approximately, e.g. a flat mesh.
 };
 
 /// Builds the MJCF of `scene`. Joints are zero at the model's reference configuration (qpos0,

@@ -131,9 +131,16 @@ Result<CellModel> CellModel::Compile(const MjcfDocument& doc) {
     auto id = FindId(m, mjOBJ_BODY, body, "body");
     if (!id) return std::unexpected(id.error());
     const int mocap = m->body_mocapid[*id];
-    if (mocap < 0)
-      return Fail(ErrorCode::kInternal, "MuJoCo model: body '" + body + "' is not mocap");
+    // A physics model's parts are free bodies: their first joint is the free joint.
+    const int joint = m->body_jntadr[*id];
+    const bool free =
+        mocap < 0 && m->body_jntnum[*id] == 1 && joint >= 0 && m->jnt_type[joint] == mjJNT_FREE;
+    if (mocap < 0 && !free) {
+      return Fail(ErrorCode::kInternal,
+                  "MuJoCo model: body '" + body + "' is neither mocap nor free");
+    }
     cell.part_mocap_.push_back(mocap);
+    cell.part_qpos_.push_back(free ? m->jnt_qposadr[joint] : -1);
   }
   return cell;
 }
@@ -174,6 +181,15 @@ Result<void> CellModel::Apply(const SceneState& state, mjData* data) const {
     const int i = part_mocap_[p];
     Eigen::Quaterniond q(X.linear());
     q.normalize();
+    if (i < 0) {
+      mjtNum* qpos = data->qpos + part_qpos_[p];
+      for (int k = 0; k < 3; ++k) qpos[k] = X.translation()[k];
+      qpos[3] = q.w();
+      qpos[4] = q.x();
+      qpos[5] = q.y();
+      qpos[6] = q.z();
+      continue;
+    }
     for (int k = 0; k < 3; ++k) data->mocap_pos[3 * i + k] = X.translation()[k];
     data->mocap_quat[4 * i + 0] = q.w();
     data->mocap_quat[4 * i + 1] = q.x();

@@ -48,7 +48,11 @@ class CellModel {
   /// allocate (reported through its error handler as kInternal by RunGuarded callers).
   std::unique_ptr<mjData, void (*)(mjData*)> MakeData() const;
 
-  /// Writes `state` into `data` (robot joints, finger slides, part mocap poses) and computes
+  /// Free-joint qpos address of part `p` in a physics model (MjcfOptions::physics), else -1.
+  int part_qpos(int p) const { return part_qpos_[p]; }
+
+  /// Writes `state` into `data` (robot joints, finger slides, part mocap poses, or the parts'
+  /// free joints in a physics model) and computes
   /// the positions of bodies, geoms, cameras and lights (mj_kinematics, mj_comPos,
   /// mj_camlight). Fails with kInvalidInput when the state's sizes do not match the model.
   Result<void> Apply(const SceneState& state, mjData* data) const;
@@ -63,7 +67,8 @@ class CellModel {
   std::unique_ptr<mjModel, ModelDeleter> model_;
   std::vector<std::vector<int>> robot_qpos_;     // qpos address per robot joint
   std::vector<std::array<int, 2>> finger_qpos_;  // qpos address per finger, -1 none
-  std::vector<int> part_mocap_;                  // mocap index per part
+  std::vector<int> part_mocap_;                  // mocap index per part, -1 free (physics)
+  std::vector<int> part_qpos_;                   // free-joint qpos address per part, -1 mocap
 };
 
 }  // namespace wrap

@@ -65,7 +65,6 @@ void PlacePedestal(const SceneTable& table, SceneRobot& robot) {
   robot.pedestal_bottom_z = bottom;
 }
 
-
 // Pose of every part in the assembly frame A after exploding: each step moves the parts of its
 // moved input back along its insertion axis by `distance` [m].
 std::vector<Iso3> ExplodedAssembly(const CellScene& scene, double distance) {
@@ -124,6 +123,7 @@ Result<CellScene> BuildCellScene(const Project& project, const ProjectCheck& che
   scene.table.size = project.table.size;
   scene.table.top_center =
       Vec3(project.table.center_xy.x(), project.table.center_xy.y(), project.table.height);
+  scene.table.friction = project.table.friction;
 
   for (const MobileBase& b : project.mobile_bases) {
     auto model = LoadMobileBase(b.model);
@@ -168,6 +168,12 @@ Result<CellScene> BuildCellScene(const Project& project, const ProjectCheck& che
     if (!shared) shared = std::make_shared<const TriangleMesh>(geometry.mesh);
     scene.parts.push_back(
         {p.name, shared, p.color, ToIsometry(p.initial_pose), ToIsometry(p.assembled_pose)});
+    // Mass properties for physics: the mesh's per-unit-density values scaled to the part's mass.
+    const MassProperties& mp = geometry.mass_properties;
+    ScenePart& added = scene.parts.back();
+    added.mass_kg = geometry.mass_kg;
+    added.com_P = mp.com;
+    if (mp.volume_m3 > 0.0) added.inertia_com = mp.inertia_com * (geometry.mass_kg / mp.volume_m3);
   }
 
   if (check.tree) {

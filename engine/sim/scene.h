@@ -51,6 +51,9 @@ struct ScenePart {
   Rgba color = {0.8, 0.8, 0.8, 1.0};         ///< Display colour.
   Iso3 X_WP_initial = Iso3::Identity();      ///< Where it starts, on the table.
   Iso3 X_AP = Iso3::Identity();              ///< Where it sits in the assembly frame A.
+  double mass_kg = 0.0;                      ///< Mass [kg] (physics; 0 when unknown).
+  Vec3 com_P = Vec3::Zero();                 ///< Centre of mass in the part frame [m].
+  Mat3 inertia_com = Mat3::Zero();           ///< Inertia about the COM, part axes [kg m^2].
 };
 
 /// One assembly step, as far as drawing needs it (the exploded goal).
@@ -64,6 +67,7 @@ struct SceneStep {
 struct SceneTable {
   Vec3 size = Vec3(1.6, 1.2, 0.05);    ///< Side lengths [m].
   Vec3 top_center = Vec3(0, 0, 0.75);  ///< Centre of the top face in the world [m].
+  double friction = 0.4;               ///< Coulomb coefficient part/table (physics).
 };
 
 /// Everything drawn, indexed like the project (robots, parts, steps in file order).

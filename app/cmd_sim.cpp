@@ -1,0 +1,80 @@
+#include <cstdio>
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "cli.h"
+#include "core/file_io.h"
+#include "core/run_context.h"
+#include "load.h"
+#include "task/plan_json.h"
+#include "verify/simulate.h"
+
+namespace wrap::cli {
+
+namespace {
+
+int Report(const Error& e, std::ostream& err) {
+  err << "wrap sim: " << e.message << "\n";
+  return ExitCodeFor(e.code);
+}
+
+std::string Percent(double u) {
+  if (u < 0.0) return "--";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.0f%%", 100.0 * u);
+  return buf;
+}
+
+}  // namespace
+
+int Sim(const SimArgs& args, std::ostream& out, std::ostream& err) {
+  if (!args.video.empty()) {
+    return Report({ErrorCode::kInvalidInput,
+                   "--video is not implemented yet (simulate without it, or render the plan with "
+                   "'wrap render --plan ... --video')"},
+                  err);
+  }
+  // The plan's own structure first: it is cheap and names the field at fault.
+  auto plan = ReadPlanFile(args.plan);
+  if (!plan) return Report(plan.error(), err);
+  const LoadedProject loaded = LoadChecked(args.project);
+  if (!ReportLoad(loaded, args.project, err, /*warnings=*/false)) return 2;
+  if (!loaded.check.tree) {
+    return Report({ErrorCode::kInternal, "the project's assembly tree is missing"}, err);
+  }
+  if (auto ok = CheckPlanMatchesProject(*plan, *loaded.project, *loaded.check.tree, args.plan);
+      !ok) {
+    return Report(ok.error(), err);
+  }
+  SimOptions options;
+  options.force_scale = args.force_scale;
+  options.mjcf_dir = args.mjcf_dir;
+  RunContext ctx;
+  auto report = SimulatePlan(*loaded.project, loaded.check, args.project, *plan, options, ctx);
+  if (!report) return Report(report.error(), err);
+  if (!args.output.empty()) {
+    if (auto ok = WriteFileAtomic(args.output, SerializeSimReport(*report)); !ok) {
+      return Report(ok.error(), err);
+    }
+  }
+  for (const std::string& w : report->warnings) err << "wrap sim: warning: " << w << "\n";
+  const SimUtilisation& u = report->peak;
+  out << (report->success ? "holds" : "fails") << ": " << report->tasks_completed << "/"
+      << report->tasks_total << " actions, " << Fmt("%.2f", report->simulated_s) << " s simulated\n"
+      << "peak utilisation: transport 2F " << Percent(u.two_finger_transport) << ", vacuum "
+      << Percent(u.vacuum_transport) << "; insertion 2F " << Percent(u.two_finger_insertion)
+      << ", vacuum " << Percent(u.vacuum_insertion) << "\n";
+  if (report->failure) {
+    const SimFailure& f = *report->failure;
+    out << "failure: action " << f.action;
+    if (f.action >= 0 && f.action < static_cast<int>(plan->actions.size())) {
+      out << " (" << DescribeAction(*plan, plan->actions[f.action]) << ")";
+    }
+    out << ": " << f.reason << " at t = " << Fmt("%.3f", f.t_s) << " s: " << f.detail << "\n";
+  }
+  if (!args.output.empty()) out << "wrote " << args.output << "\n";
+  return report->success ? 0 : 1;
+}
+
+}  // namespace wrap::cli

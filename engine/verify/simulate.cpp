@@ -1,0 +1,661 @@
+#include "verify/simulate.h"
+
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+
+#include "robot/kinematics.h"
+#include "sim/mjcf.h"
+#include "sim/mujoco_model.h"
+#include "sim/scene.h"
+
+namespace wrap {
+
+namespace {
+
+constexpr int kWeldRows = 6;  // a weld constrains 3 positions and 3 rotations
+
+double AngleOf(const Mat3& R) { return std::abs(Eigen::AngleAxisd(R).angle()); }
+
+std::string Num(double v, int digits = 3) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+// Where the two inputs of a step meet, chosen as the planner does (task/world.cpp): the pair
+// of parts whose boxes in A overlap most, the centre of that overlap as the contact point.
+struct Interface {
+  int part_moved = -1;
+  int part_base = -1;
+  Vec3 p_A = Vec3::Zero();
+  Vec3 axis_A = Vec3::UnitZ();
+  double force_N = 0.0;
+  double torque_Nm = 0.0;
+};
+
+Aabb PartBoxInA(const ScenePart& part) {
+  Aabb box;
+  box.min = Vec3::Constant(std::numeric_limits<double>::infinity());
+  box.max = -box.min;
+  for (const Vec3& v : part.mesh->vertices) {
+    const Vec3 a = part.X_AP * v;
+    box.min = box.min.cwiseMin(a);
+    box.max = box.max.cwiseMax(a);
+  }
+  return box;
+}
+
+Interface FindInterface(const CellScene& scene, const AssemblyTree& tree, const Mating& mating,
+                        int moved, int base) {
+  Interface out;
+  out.axis_A = mating.axis.norm() > 0.0 ? mating.axis.normalized() : Vec3::UnitZ();
+  out.force_N = mating.force_N;
+  out.torque_Nm = mating.torque_Nm;
+  double best = -1.0;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int pm : tree.nodes[moved].parts) {
+    for (int pb : tree.nodes[base].parts) {
+      const Aabb a = PartBoxInA(scene.parts[pm]);
+      const Aabb b = PartBoxInA(scene.parts[pb]);
+      const Vec3 lo = a.min.cwiseMax(b.min) - Vec3::Constant(1e-3);
+      const Vec3 hi = a.max.cwiseMin(b.max) + Vec3::Constant(1e-3);
+      if ((hi.array() > lo.array()).all()) {
+        const double v = (hi - lo).prod();
+        if (v > best) {
+          best = v;
+          out.part_moved = pm;
+          out.part_base = pb;
+          out.p_A = 0.5 * (lo + hi);
+        }
+      } else if (best < 0.0) {
+        const Vec3 cm = 0.5 * (a.min + a.max);
+        const Vec3 cb = 0.5 * (b.min + b.max);
+        if ((cm - cb).norm() < nearest) {
+          nearest = (cm - cb).norm();
+          out.part_moved = pm;
+          out.part_base = pb;
+          out.p_A = 0.5 * (cm + cb);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+// Utilisation of a wrench (force, torque) against a symmetric box: the largest |component| /
+// bound, a zero bound taken as the floor.
+double BoxUtilisation(const Vec3& f, const Vec3& tau, const WrenchBox& box, double floor_N,
+                      double floor_Nm) {
+  double u = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    u = std::max(u, std::abs(f[i]) / std::max(box.force_N[i], floor_N));
+    u = std::max(u, std::abs(tau[i]) / std::max(box.torque_Nm[i], floor_Nm));
+  }
+  return u;
+}
+
+struct ModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+struct DataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+
+class Simulator {
+ public:
+  Simulator(const Project& project, const CellScene& scene, const AssemblyTree& tree,
+            const Plan& plan, const SimOptions& options, RunContext& ctx)
+      : project_(project), scene_(scene), tree_(tree), plan_(plan), options_(options), ctx_(ctx) {}
+
+  Result<SimReport> Run() {
+    if (auto ok = Setup(); !ok) return std::unexpected(ok.error());
+    Result<void> cancelled;
+    auto guarded = RunGuarded("simulating the plan", [&] { cancelled = Loop(); });
+    if (!guarded) return std::unexpected(guarded.error());
+    if (!cancelled) return std::unexpected(cancelled.error());
+    for (std::string& w : TakeMujocoWarnings()) report_.warnings.push_back("MuJoCo: " + w);
+    report_.success = !report_.failure.has_value();
+    return std::move(report_);
+  }
+
+ private:
+  struct Object {
+    Iso3 X_WA = Iso3::Identity();  // where it should be while nobody holds it
+    std::vector<int> holders;      // robots, ascending
+    int last_action = -1;          // the last action that changed its support
+  };
+
+  Result<void> Setup() {
+    const int nr = static_cast<int>(scene_.robots.size());
+    const int np = static_cast<int>(scene_.parts.size());
+    report_.tasks_total = static_cast<int>(plan_.actions.size());
+    for (const PlanAction& a : plan_.actions) {
+      report_.actions.push_back({std::string(ToString(a.type)), "not reached", -1.0});
+    }
+    // Initial state: robots at the start of their trajectories, parts as the plan begins.
+    SceneState state;
+    for (int r = 0; r < nr; ++r) {
+      state.q.push_back(SampleTrajectory(plan_.trajectories[r], 0.0));
+      state.opening_m.push_back(scene_.robots[r].end_effector.stroke_m);
+    }
+    state.X_WP.assign(np, Iso3::Identity());
+    for (const PlanObject& o : plan_.initial.objects) {
+      objects_[o.node] = {o.X_WA, {}, -1};
+      for (int p : tree_.nodes[o.node].parts) state.X_WP[p] = o.X_WA * scene_.parts[p].X_AP;
+    }
+    MjcfOptions mo;
+    mo.physics = true;
+    mo.timestep_s = options_.timestep_s;
+    mo.shadows = false;
+    auto doc = BuildCellMjcf(scene_, state, mo);
+    if (!doc) return std::unexpected(doc.error());
+    for (const std::string& w : doc->warnings) report_.warnings.push_back(w);
+    if (!options_.mjcf_dir.empty()) {
+      if (auto ok = WriteMjcf(*doc, options_.mjcf_dir); !ok) return ok;
+    }
+    auto cell = CellModel::Compile(*doc);
+    if (!cell) return std::unexpected(cell.error());
+    // Our own copy: welds are switched on and retargeted in the model (eq_active, eq_data).
+    auto guarded = RunGuarded("preparing the physics model", [&] {
+      model_.reset(mj_copyModel(nullptr, cell->model()));
+      data_.reset(mj_makeData(model_.get()));
+    });
+    if (!guarded) return std::unexpected(guarded.error());
+    if (auto ok = cell->Apply(state, data_.get()); !ok) return ok;
+    const mjModel* m = model_.get();
+    for (int r = 0; r < nr; ++r) {
+      const int body = mj_name2id(m, mjOBJ_BODY, doc->tcp_bodies[r].c_str());
+      if (body < 0 || m->body_mocapid[body] < 0) {
+        return Fail(ErrorCode::kInternal, "sim: no TCP mocap body for robot " + std::to_string(r));
+      }
+      tcp_mocap_.push_back(m->body_mocapid[body]);
+      std::vector<int> ids;
+      for (int p = 0; p < np; ++p) {
+        ids.push_back(mj_name2id(m, mjOBJ_EQUALITY, doc->grip_welds[r][p].c_str()));
+      }
+      grip_eq_.push_back(std::move(ids));
+    }
+    join_eq_.assign(np, std::vector<int>(np, -1));
+    for (int p = 0; p < np; ++p) {
+      part_body_.push_back(mj_name2id(m, mjOBJ_BODY, doc->part_bodies[p].c_str()));
+      part_dof_.push_back(m->jnt_dofadr[m->body_jntadr[part_body_.back()]]);
+      for (int q = p + 1; q < np; ++q) {
+        join_eq_[p][q] = mj_name2id(m, mjOBJ_EQUALITY, doc->join_welds[p][q].c_str());
+      }
+    }
+    // Limits, grips and the steps' interfaces.
+    for (const Robot& r : project_.robots) {
+      limits_.push_back(r.wrench_limits.value_or(project_.wrench_limits));
+    }
+    grip_part_.assign(nr, -1);
+    grasp_.assign(nr, PlanGrasp{});
+    hold_f_.assign(nr, Vec3::Zero());
+    hold_tau_.assign(nr, Vec3::Zero());
+    was_inserting_.assign(nr, false);
+    for (size_t i = 0; i < plan_.actions.size(); ++i) {
+      const PlanAction& a = plan_.actions[i];
+      if (a.type != ActionType::kAssemble) continue;
+      const int step = tree_.nodes[a.objects[2]].step;
+      interfaces_[static_cast<int>(i)] =
+          FindInterface(scene_, tree_, project_.steps[step].mating, a.objects[0], a.objects[1]);
+    }
+    order_.resize(plan_.actions.size());
+    for (size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<int>(i);
+    std::stable_sort(order_.begin(), order_.end(),
+                     [&](int a, int b) { return plan_.actions[a].end_s < plan_.actions[b].end_s; });
+    for (const RobotTrajectory& tr : plan_.trajectories) {
+      makespan_ = std::max(makespan_, tr.knots.back().t);
+    }
+    for (const PlanAction& a : plan_.actions) makespan_ = std::max(makespan_, a.end_s);
+    SetTcps(0.0);
+    mj_forward(model_.get(), data_.get());
+    return {};
+  }
+
+  // The action running at `t`: the first (in time order) whose moment has not passed.
+  int CurrentAction() const {
+    if (next_event_ < order_.size()) return order_[next_event_];
+    return order_.empty() ? -1 : order_.back();
+  }
+
+  Iso3 Tcp(int r, double t) const {
+    const SceneRobot& robot = scene_.robots[r];
+    return TcpPose(robot.chain, robot.X_WB, SampleTrajectory(plan_.trajectories[r], t),
+                   robot.end_effector.X_FT);
+  }
+
+  void SetTcps(double t) {
+    for (size_t r = 0; r < tcp_mocap_.size(); ++r) {
+      const Iso3 X = Tcp(static_cast<int>(r), t);
+      const int i = tcp_mocap_[r];
+      Eigen::Quaterniond q(X.linear());
+      q.normalize();
+      for (int k = 0; k < 3; ++k) data_->mocap_pos[3 * i + k] = X.translation()[k];
+      data_->mocap_quat[4 * i + 0] = q.w();
+      data_->mocap_quat[4 * i + 1] = q.x();
+      data_->mocap_quat[4 * i + 2] = q.y();
+      data_->mocap_quat[4 * i + 3] = q.z();
+    }
+  }
+
+  Iso3 BodyPose(int body) const {
+    Iso3 X = Iso3::Identity();
+    const mjtNum* p = data_->xpos + 3 * body;
+    const mjtNum* q = data_->xquat + 4 * body;
+    X.translation() = Vec3(p[0], p[1], p[2]);
+    X.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+    return X;
+  }
+  Iso3 PartPose(int p) const { return BodyPose(part_body_[p]); }
+  Iso3 TcpBodyPose(int r) const {
+    Iso3 X = Iso3::Identity();
+    const int i = tcp_mocap_[r];
+    X.translation() =
+        Vec3(data_->mocap_pos[3 * i], data_->mocap_pos[3 * i + 1], data_->mocap_pos[3 * i + 2]);
+    X.linear() = Eigen::Quaterniond(data_->mocap_quat[4 * i], data_->mocap_quat[4 * i + 1],
+                                    data_->mocap_quat[4 * i + 2], data_->mocap_quat[4 * i + 3])
+                     .normalized()
+                     .toRotationMatrix();
+    return X;
+  }
+
+  // Switches weld `eq` on with body2 held where it is now relative to body1.
+  void Weld(int eq, const Iso3& X_W1, const Iso3& X_W2) {
+    const Iso3 X_12 = X_W1.inverse() * X_W2;
+    mjtNum* e = model_->eq_data + mjNEQDATA * eq;
+    // eq_data of a weld in 2.2: anchor (3), relative position (3), relative quaternion (4),
+    // torque scale (1); the relative pose is body2's in body1's frame.
+    Eigen::Quaterniond q(X_12.linear());
+    q.normalize();
+    for (int k = 0; k < 3; ++k) e[3 + k] = X_12.translation()[k];
+    e[6] = q.w();
+    e[7] = q.x();
+    e[8] = q.y();
+    e[9] = q.z();
+    model_->eq_active[eq] = 1;
+  }
+
+  void Grip(int r, const PlanGrasp& g) {
+    Release(r);
+    if (g.part < 0 || g.part >= static_cast<int>(part_body_.size())) return;
+    grip_part_[r] = g.part;
+    grasp_[r] = g;
+    Weld(grip_eq_[r][g.part], TcpBodyPose(r), PartPose(g.part));
+  }
+
+  void Release(int r) {
+    if (grip_part_[r] >= 0) model_->eq_active[grip_eq_[r][grip_part_[r]]] = 0;
+    grip_part_[r] = -1;
+  }
+
+  // Where the plan has an object now: carried by its first holder, else where it was left.
+  Iso3 ExpectedX_WA(const Object& o) const {
+    if (o.holders.empty()) return o.X_WA;
+    const int r = o.holders.front();
+    const PlanGrasp& g = grasp_[r];
+    return TcpBodyPose(r) * (scene_.parts[g.part].X_AP * g.X_PG).inverse();
+  }
+
+  void Failed(int action, const std::string& reason, const std::string& detail, double t) {
+    if (report_.failure) return;
+    report_.failure = SimFailure{action, reason, detail, t};
+    if (action >= 0) report_.actions[action].status = "failed";
+  }
+
+  // The moment of action i: grips close or open, connections are made.
+  void Event(int i, double t) {
+    const PlanAction& a = plan_.actions[i];
+    const int node = a.objects.empty() ? -1 : a.objects[0];
+    auto take = [&](int r, const PlanGrasp& g) {
+      Object& o = objects_[node];
+      o.holders.push_back(r);
+      std::sort(o.holders.begin(), o.holders.end());
+      Grip(r, g);
+    };
+    auto drop = [&](int r) {
+      Object& o = objects_[node];
+      if (o.holders.size() == 1 && o.holders.front() == r) o.X_WA = ExpectedX_WA(o);
+      o.holders.erase(std::remove(o.holders.begin(), o.holders.end(), r), o.holders.end());
+      Release(r);
+    };
+    switch (a.type) {
+      case ActionType::kPick:
+      case ActionType::kAddGrasp:
+        take(a.robots[0], a.grasps[0].grasp);
+        break;
+      case ActionType::kPlace:
+      case ActionType::kRelease:
+        drop(a.robots[0]);
+        break;
+      case ActionType::kHandover:
+        take(a.robots[1], a.grasps[1].grasp);
+        drop(a.robots[0]);
+        break;
+      case ActionType::kAssemble: {
+        const Interface& in = interfaces_.at(i);
+        // The mated pose: the moved part relative to the base part against the assembly.
+        const Iso3 X_WPm = PartPose(in.part_moved);
+        const Iso3 X_WPb = PartPose(in.part_base);
+        const Iso3 actual = X_WPb.inverse() * X_WPm;
+        const Iso3 nominal =
+            scene_.parts[in.part_base].X_AP.inverse() * scene_.parts[in.part_moved].X_AP;
+        const double dp = (actual.translation() - nominal.translation()).norm();
+        const double da = AngleOf(actual.linear().transpose() * nominal.linear());
+        if (dp > options_.misalign_tolerance_m || da > options_.misalign_tolerance_rad) {
+          Failed(i, "misalignment",
+                 "'" + scene_.parts[in.part_moved].name + "' mated " + Num(1000 * dp) + " mm and " +
+                     Num(da * 180 / M_PI) + " deg off its pose on '" +
+                     scene_.parts[in.part_base].name + "'",
+                 t);
+          return;
+        }
+        const int p = std::min(in.part_moved, in.part_base);
+        const int q = std::max(in.part_moved, in.part_base);
+        Weld(join_eq_[p][q], PartPose(p), PartPose(q));
+        Object merged = objects_[a.objects[1]];
+        for (int r : objects_[a.objects[0]].holders) merged.holders.push_back(r);
+        std::sort(merged.holders.begin(), merged.holders.end());
+        objects_.erase(a.objects[0]);
+        objects_.erase(a.objects[1]);
+        objects_[a.objects[2]] = merged;
+        objects_[a.objects[2]].last_action = i;
+        break;
+      }
+    }
+    if (a.type != ActionType::kAssemble && node >= 0) objects_[node].last_action = i;
+    report_.actions[i].status = "completed";
+    ++report_.tasks_completed;
+  }
+
+  // The assemble actions whose insertion runs at t.
+  std::vector<int> Insertions(double t) const {
+    std::vector<int> out;
+    for (const MotionSegment& s : plan_.segments) {
+      if (s.kind == "insert" && s.start_s <= t && t < s.end_s && interfaces_.count(s.action)) {
+        out.push_back(s.action);
+      }
+    }
+    return out;
+  }
+
+  // The mating wrench on both inputs of assemble action i, at their interface point.
+  void ApplyMating(int i) {
+    const Interface& in = interfaces_.at(i);
+    const Iso3 X_WPb = PartPose(in.part_base);
+    const Iso3 X_WA = X_WPb * scene_.parts[in.part_base].X_AP.inverse();
+    const Vec3 axis_W = X_WA.linear() * in.axis_A;
+    const Vec3 p_W = X_WA * in.p_A;
+    const double s = options_.force_scale;
+    // The base resists the moved input: on it -F along the axis, on the base +F.
+    const Vec3 f_moved = -s * in.force_N * axis_W;
+    const Vec3 tau_moved = -s * in.torque_Nm * axis_W;
+    for (int side = 0; side < 2; ++side) {
+      const int body = part_body_[side == 0 ? in.part_moved : in.part_base];
+      const double sign = side == 0 ? 1.0 : -1.0;
+      const Vec3 f = sign * f_moved;
+      const Vec3 com(data_->xipos[3 * body], data_->xipos[3 * body + 1],
+                     data_->xipos[3 * body + 2]);
+      const Vec3 tau = sign * tau_moved + (p_W - com).cross(f);
+      mjtNum* x = data_->xfrc_applied + 6 * body;
+      for (int k = 0; k < 3; ++k) {
+        x[k] += f[k];
+        x[3 + k] += tau[k];
+      }
+    }
+  }
+
+  // The wrench robot r's weld exerts on its part, in the TCP (grasp) frame about its origin.
+  void GripWrench(int r, Vec3& f_G, Vec3& tau_G) const {
+    const mjModel* m = model_.get();
+    const mjData* d = data_.get();
+    const int p = grip_part_[r];
+    const int eq = grip_eq_[r][p];
+    const int dof = part_dof_[p];
+    double gen[6] = {0, 0, 0, 0, 0, 0};
+    int rows = 0;
+    for (int row = 0; row < d->nefc && rows < kWeldRows; ++row) {
+      if (d->efc_type[row] != mjCNSTR_EQUALITY || d->efc_id[row] != eq) continue;
+      ++rows;
+      for (int j = 0; j < 6; ++j) gen[j] += d->efc_J[row * m->nv + dof + j] * d->efc_force[row];
+    }
+    // A free joint's generalised force: world force, then torque in the body frame about its
+    // origin (the part frame).
+    const Iso3 X_WP = PartPose(p);
+    const Iso3 X_WG = TcpBodyPose(r);
+    const Vec3 f_W(gen[0], gen[1], gen[2]);
+    const Vec3 tau_W = X_WP.linear() * Vec3(gen[3], gen[4], gen[5]) +
+                       (X_WP.translation() - X_WG.translation()).cross(f_W);
+    f_G = X_WG.linear().transpose() * f_W;
+    tau_G = X_WG.linear().transpose() * tau_W;
+  }
+
+  void Measure(double t, const std::vector<int>& inserting) {
+    const int current = CurrentAction();
+    // Grippers against their limits.
+    for (size_t ri = 0; ri < grip_part_.size(); ++ri) {
+      const int r = static_cast<int>(ri);
+      if (grip_part_[r] < 0) {
+        was_inserting_[r] = false;
+        continue;
+      }
+      Vec3 f, tau;
+      GripWrench(r, f, tau);
+      int insert_action = -1;
+      for (int i : inserting) {
+        const auto& rs = plan_.actions[i].robots;
+        if (std::find(rs.begin(), rs.end(), r) != rs.end()) insert_action = i;
+      }
+      const bool vacuum = scene_.robots[r].end_effector.kind == EndEffectorKind::kVacuum;
+      const WrenchLimits& lim = limits_[r];
+      const double fN = options_.zero_limit_force_N, fNm = options_.zero_limit_torque_Nm;
+      double u = 0.0;
+      if (!vacuum) {
+        u = BoxUtilisation(f, tau, lim.two_finger, fN, fNm);
+      } else if (insert_action < 0) {
+        u = BoxUtilisation(f, tau, lim.vacuum_transport, fN, fNm);
+      } else {
+        // Held, then mated (wrench.h): the weight within the transport box, what the mating
+        // adds within the assembly box.
+        if (!was_inserting_[r]) {
+          hold_f_[r] = f;
+          hold_tau_[r] = tau;
+        }
+        u = std::max(
+            BoxUtilisation(f, tau, lim.vacuum_transport, fN, fNm),
+            BoxUtilisation(f - hold_f_[r], tau - hold_tau_[r], lim.vacuum_assembly, fN, fNm));
+      }
+      was_inserting_[r] = insert_action >= 0;
+      double& peak = vacuum ? (insert_action >= 0 ? report_.peak.vacuum_insertion
+                                                  : report_.peak.vacuum_transport)
+                            : (insert_action >= 0 ? report_.peak.two_finger_insertion
+                                                  : report_.peak.two_finger_transport);
+      peak = std::max(peak, u);
+      const int blamed = insert_action >= 0 ? insert_action : current;
+      if (blamed >= 0) {
+        report_.actions[blamed].peak_utilisation =
+            std::max(report_.actions[blamed].peak_utilisation, u);
+      }
+      if (u > 1.0) {
+        Failed(blamed, vacuum ? "vacuum limit" : "slip",
+               "robot '" + scene_.robots[r].name + "' at " + Num(100 * u) + "% of its " +
+                   (vacuum ? (insert_action >= 0 ? "vacuum assembly/transport" : "vacuum transport")
+                           : "two-finger") +
+                   " limits (force " + Num(f.x()) + ", " + Num(f.y()) + ", " + Num(f.z()) +
+                   " N, torque " + Num(tau.x()) + ", " + Num(tau.y()) + ", " + Num(tau.z()) +
+                   " N m in the grasp frame)",
+               t);
+        return;
+      }
+    }
+    // Every part where the plan has it.
+    for (const auto& [node, o] : objects_) {
+      const Iso3 X_WA = ExpectedX_WA(o);
+      for (int p : tree_.nodes[node].parts) {
+        const Iso3 expected = X_WA * scene_.parts[p].X_AP;
+        const Iso3 actual = PartPose(p);
+        const double dp = (actual.translation() - expected.translation()).norm();
+        const double da = AngleOf(actual.linear().transpose() * expected.linear());
+        if (dp > options_.drift_tolerance_m || da > options_.drift_tolerance_rad) {
+          const int blamed = o.holders.empty() && o.last_action >= 0 ? o.last_action : current;
+          Failed(blamed, "no support",
+                 "'" + scene_.parts[p].name + "' is " + Num(1000 * dp) + " mm and " +
+                     Num(da * 180 / M_PI) + " deg from where the plan has it" +
+                     (o.holders.empty() ? " (nobody holds it)" : ""),
+                 t);
+          return;
+        }
+      }
+    }
+  }
+
+  // The final assembly: every part against the assembly's relative poses.
+  void CheckFinal(double t) {
+    for (const auto& [node, o] : objects_) {
+      const std::vector<int>& parts = tree_.nodes[node].parts;
+      if (parts.size() < 2) continue;
+      const int ref = parts.front();
+      const Iso3 X_WA = PartPose(ref) * scene_.parts[ref].X_AP.inverse();
+      for (int p : parts) {
+        const Iso3 expected = X_WA * scene_.parts[p].X_AP;
+        const Iso3 actual = PartPose(p);
+        const double dp = (actual.translation() - expected.translation()).norm();
+        const double da = AngleOf(actual.linear().transpose() * expected.linear());
+        report_.final_position_error_m = std::max(report_.final_position_error_m, dp);
+        report_.final_angle_error_rad = std::max(report_.final_angle_error_rad, da);
+      }
+    }
+    if (report_.final_position_error_m > options_.misalign_tolerance_m ||
+        report_.final_angle_error_rad > options_.misalign_tolerance_rad) {
+      Failed(order_.empty() ? -1 : order_.back(), "misalignment",
+             "final assembly " + Num(1000 * report_.final_position_error_m) + " mm and " +
+                 Num(report_.final_angle_error_rad * 180 / M_PI) + " deg off",
+             t);
+    }
+  }
+
+  Result<void> Loop() {
+    const double dt = model_->opt.timestep;
+    const double t_end = makespan_ + std::max(0.0, options_.settle_s);
+    const long long n_steps = static_cast<long long>(std::ceil(t_end / dt));
+    const int every = std::max(1, options_.sample_every);
+    for (long long k = 0; k < n_steps; ++k) {
+      const double t = k * dt;
+      while (next_event_ < order_.size() && plan_.actions[order_[next_event_]].end_s <= t) {
+        Event(order_[next_event_++], t);
+        if (report_.failure) break;
+      }
+      if (report_.failure) break;
+      SetTcps(t);
+      mju_zero(data_->xfrc_applied, 6 * model_->nbody);
+      const std::vector<int> inserting = Insertions(t);
+      for (int i : inserting) ApplyMating(i);
+      mj_step(model_.get(), data_.get());
+      report_.steps = k + 1;
+      report_.simulated_s = t + dt;
+      if (k % every == 0) {
+        Measure(t, inserting);
+        if (report_.failure) break;
+      }
+      if (k % 1000 == 0 && ctx_.ShouldStop()) {
+        return wrap::Fail(ErrorCode::kCancelled, "sim: stopped at t = " + Num(t) + " s");
+      }
+    }
+    if (!report_.failure) CheckFinal(report_.simulated_s);
+    return {};
+  }
+
+  const Project& project_;
+  const CellScene& scene_;
+  const AssemblyTree& tree_;
+  const Plan& plan_;
+  const SimOptions& options_;
+  RunContext& ctx_;
+  SimReport report_;
+
+  std::unique_ptr<mjModel, ModelDeleter> model_;
+  std::unique_ptr<mjData, DataDeleter> data_;
+  std::vector<int> tcp_mocap_;             // mocap index per robot
+  std::vector<std::vector<int>> grip_eq_;  // [robot][part] weld id
+  std::vector<std::vector<int>> join_eq_;  // [p][q] weld id, p < q
+  std::vector<int> part_body_, part_dof_;  // per part
+  std::vector<WrenchLimits> limits_;       // per robot
+  std::vector<int> grip_part_;             // per robot, -1 free
+  std::vector<PlanGrasp> grasp_;           // per robot, its current grasp
+  std::vector<Vec3> hold_f_, hold_tau_;    // per robot, wrench when its insertion began
+  std::vector<bool> was_inserting_;        // per robot
+  std::map<int, Interface> interfaces_;    // per assemble action
+  std::map<int, Object> objects_;          // by node id
+  std::vector<int> order_;                 // actions by end_s
+  size_t next_event_ = 0;
+  double makespan_ = 0.0;
+};
+
+}  // namespace
+
+Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check,
+                               const std::filesystem::path& project_file, const Plan& plan,
+                               const SimOptions& options, RunContext& ctx) {
+  InstallMujocoHandlers();
+  auto bad = [](const std::string& m) { return Fail(ErrorCode::kInvalidInput, "sim: " + m); };
+  if (!check.tree) return bad("the project's assembly DAG is not well formed");
+  if (!(options.timestep_s > 0.0 && options.timestep_s <= 0.01)) {
+    return bad("timestep must be in (0, 0.01] s");
+  }
+  if (!(options.force_scale >= 0.0) || !std::isfinite(options.force_scale)) {
+    return bad("force scale must be a finite number >= 0");
+  }
+  auto scene = BuildCellScene(project, check, project_file);
+  if (!scene) return std::unexpected(scene.error());
+  const AssemblyTree& tree = *check.tree;
+  if (plan.trajectories.size() != scene->robots.size()) {
+    return bad("the plan has no trajectories for the cell's " +
+               std::to_string(scene->robots.size()) +
+               " robots (plan it with motion: 'wrap plan' without --task-only)");
+  }
+  for (size_t r = 0; r < scene->robots.size(); ++r) {
+    const RobotTrajectory& tr = plan.trajectories[r];
+    if (tr.knots.empty() || tr.knots.front().q.size() != scene->robots[r].chain.dof()) {
+      return bad("trajectories[" + std::to_string(r) + "]: the trajectory of robot '" +
+                 scene->robots[r].name + "' does not fit its " +
+                 std::to_string(scene->robots[r].chain.dof()) + " joints");
+    }
+  }
+  const int n_nodes = static_cast<int>(tree.nodes.size());
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    const PlanAction& a = plan.actions[i];
+    const std::string where = "actions[" + std::to_string(i) + "]: ";
+    if (!(a.end_s >= 0.0)) return bad(where + "no timing (end_s); the plan has no motion");
+    const size_t n_robots = a.type == ActionType::kHandover ? 2 : 1;
+    if (a.robots.size() < n_robots || a.grasps.size() < n_robots) {
+      return bad(where + "expected " + std::to_string(n_robots) + " robots with grasps");
+    }
+    for (int r : a.robots) {
+      if (r < 0 || r >= static_cast<int>(scene->robots.size())) return bad(where + "bad robot");
+    }
+    const size_t n_objects = a.type == ActionType::kAssemble ? 3 : 1;
+    if (a.objects.size() < n_objects) return bad(where + "too few objects");
+    for (int o : a.objects) {
+      if (o < 0 || o >= n_nodes) return bad(where + "object is not a node of the assembly");
+    }
+    if (a.type == ActionType::kAssemble && tree.nodes[a.objects[2]].step < 0) {
+      return bad(where + "the assembled object is not a step");
+    }
+  }
+  std::vector<int> seen(scene->parts.size(), 0);
+  for (const PlanObject& o : plan.initial.objects) {
+    if (o.node < 0 || o.node >= n_nodes) return bad("initial: object is not a node");
+    for (int p : tree.nodes[o.node].parts) ++seen[p];
+  }
+  for (size_t p = 0; p < seen.size(); ++p) {
+    if (seen[p] != 1) return bad("initial: part '" + scene->parts[p].name + "' is not placed once");
+  }
+  Simulator sim(project, *scene, tree, plan, options, ctx);
+  return sim.Run();
+}
+
+}  // namespace wrap

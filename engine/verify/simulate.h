@@ -1,0 +1,97 @@
+// Physics verification of a plan (paper §V-B, table "simulation success"): the plan's timed
+// trajectories run in MuJoCo 2.2 on the physics variant of the cell's MJCF (sim/mjcf.h). Parts
+// are free bodies on the table under gravity and friction; each robot's TCP is a mocap body
+// driven kinematically along its trajectory (forward kinematics at every step: the arm is not
+// simulated, so joint tracking errors and arm dynamics are not part of the verdict); a grasped
+// part is welded to the TCP from the grasp to the release; during an insertion the project's
+// mating wrench acts on the two inputs at their interface as an external wrench; a made
+// connection is welded. The weld forces give each gripper's wrench in its grasp frame, compared
+// with its limits as a utilisation.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/result.h"
+#include "core/run_context.h"
+#include "model/project.h"
+#include "model/validate.h"
+#include "task/plan.h"
+
+namespace wrap {
+
+/// Options of SimulatePlan, with their defaults.
+struct SimOptions {
+  double timestep_s = 0.001;         ///< Integration step [s].
+  double settle_s = 1.0;             ///< Simulated after the last action [s].
+  double drift_tolerance_m = 0.03;   ///< A part this far from where the plan has it: "no support".
+  double drift_tolerance_rad = 0.3;  ///< ... or turned this far from it [rad].
+  double misalign_tolerance_m = 0.01;   ///< Mated or final relative pose error: "misalignment".
+  double misalign_tolerance_rad = 0.1;  ///< ... in rotation [rad].
+  double force_scale = 1.0;             ///< Lambda on the applied mating wrench (>= 0).
+  /// A gripper limit of 0 (vacuum: no lateral force while mating) is taken as this small bound
+  /// when computing utilisation, so that measurement noise does not count as a violation [N].
+  double zero_limit_force_N = 1.0;
+  double zero_limit_torque_Nm = 0.05;  ///< Same for torques [N m].
+  int sample_every = 5;                ///< Measure wrenches and drift every this many steps.
+  /// When set, the physics model is also written here (cell.xml and meshes, sim/mjcf.h
+  /// WriteMjcf), e.g. to open it in MuJoCo's `simulate`.
+  std::filesystem::path mjcf_dir;
+};
+
+/// Peak utilisations (1 = 100% of the limit) by phase and end-effector type; -1 where no gripper
+/// of that type held anything in that phase.
+struct SimUtilisation {
+  double two_finger_transport = -1.0;  ///< Two-finger grippers carrying or holding.
+  double two_finger_insertion = -1.0;  ///< Two-finger grippers during insertions.
+  double vacuum_transport = -1.0;      ///< Vacuum grippers carrying or holding.
+  double vacuum_insertion = -1.0;      ///< Vacuum grippers during insertions.
+};
+
+/// What happened to one action of the plan.
+struct SimActionStatus {
+  std::string type;              ///< "pick", "place", ...
+  std::string status;            ///< "completed", "failed" or "not reached".
+  double peak_utilisation = -1;  ///< Highest utilisation of its robots while it ran; -1 none.
+};
+
+/// Why a plan failed in simulation.
+struct SimFailure {
+  int action = -1;     ///< Index of the action blamed.
+  std::string reason;  ///< "no support", "slip", "vacuum limit", "misalignment".
+  std::string detail;  ///< In words: which part or robot, the numbers seen.
+  double t_s = 0.0;    ///< Simulated time it was detected [s].
+};
+
+/// The verdict of a simulation.
+struct SimReport {
+  bool success = false;                  ///< The plan ran to the end with no failure.
+  int tasks_completed = 0;               ///< Actions completed before the failure.
+  int tasks_total = 0;                   ///< Actions of the plan.
+  std::vector<SimActionStatus> actions;  ///< One per plan action.
+  SimUtilisation peak;                   ///< Peak utilisations.
+  std::optional<SimFailure> failure;     ///< Null when it holds.
+  double final_position_error_m = 0.0;   ///< Worst part position error in the final assembly [m].
+  double final_angle_error_rad = 0.0;    ///< Worst part rotation error in it [rad].
+  double simulated_s = 0.0;              ///< Simulated time [s].
+  long long steps = 0;                   ///< Integration steps.
+  std::string driving = "kinematic TCP mocap";  ///< How the robots are driven.
+  std::vector<std::string> warnings;            ///< MuJoCo warnings, approximated meshes.
+};
+
+/// Simulates `plan` (with trajectories) of `project` (validated: `check` holds its meshes and
+/// tree; `project_file` resolves URDFs). Fails with kInvalidInput when the plan has no motion or
+/// does not fit the cell, kInternal with MuJoCo's message when MuJoCo raises an error (never
+/// exits), kCancelled when `ctx` stops. A plan that fails in simulation is a SimReport with
+/// success false, not an error.
+Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check,
+                               const std::filesystem::path& project_file, const Plan& plan,
+                               const SimOptions& options, RunContext& ctx);
+
+/// The report as JSON text (2-space indent, final newline): success, tasks, actions, peak
+/// utilisations in percent (null where absent), failure {action, reason, detail, t_s} or null.
+std::string SerializeSimReport(const SimReport& report);
+
+}  // namespace wrap
