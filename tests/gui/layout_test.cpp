@@ -25,7 +25,9 @@ TEST(GraphLayout, InputsStandLeftOfTheirStepAndPartsInTheFirstColumn) {
   // No two nodes on the same spot.
   for (const auto& [a, pa] : graph.pos) {
     for (const auto& [b, pb] : graph.pos) {
-      if (a < b) EXPECT_FALSE(pa.x == pb.x && pa.y == pb.y) << a << " and " << b;
+      if (a < b) {
+        EXPECT_FALSE(pa.x == pb.x && pa.y == pb.y) << a << " and " << b;
+      }
     }
   }
 }

@@ -3,6 +3,7 @@
 #include <imgui.h>
 #include <imgui_stdlib.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <ostream>
@@ -392,13 +393,63 @@ class App {
     }
     if (!s_.viewport.ready()) return;
     const CellScene& scene = s_.viewport.scene();
-    (void)s_.viewport.SetState(CurrentState());
+    const SceneState state = CurrentState();
+    (void)s_.viewport.SetState(state);
     int selected = -1;
     for (size_t i = 0; i < scene.parts.size(); ++i) {
       if (scene.parts[i].name == s_.selection.part) selected = static_cast<int>(i);
     }
     s_.viewport.set_selected_part(selected);
-    s_.viewport.set_arrow(StepArrow());
+    std::vector<SceneArrow> arrows;
+    if (auto arrow = StepArrow()) arrows.push_back(*arrow);
+    std::vector<SceneMarker> markers;
+    PlanMarks(state, selected, arrows, markers);
+    s_.viewport.set_arrows(std::move(arrows));
+    s_.viewport.set_markers(std::move(markers));
+  }
+
+  /// With a plan of this cell on show: the grasps it uses on the selected part (arrows along
+  /// each grasp's approach axis, ending at the TCP, on the part where it is now) and where its
+  /// place actions set objects down (discs on the table).
+  void PlanMarks(const SceneState& state, int selected, std::vector<SceneArrow>& arrows,
+                 std::vector<SceneMarker>& markers) {
+    const CellScene& scene = s_.viewport.scene();
+    if (!s_.plan || s_.plan->parts.size() != scene.parts.size()) return;
+    const Plan& plan = *s_.plan;
+    if (selected >= 0 && selected < static_cast<int>(state.X_WP.size())) {
+      std::vector<std::pair<int, int>> seen;  // (subassembly, index) of each grasp drawn
+      for (const PlanAction& a : plan.actions) {
+        for (const PlanHold& h : a.grasps) {
+          const PlanGrasp& g = h.grasp;
+          if (g.part != selected) continue;
+          const std::pair<int, int> key{g.subassembly, g.index};
+          if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
+          seen.push_back(key);
+          const Iso3 X_WG = state.X_WP[selected] * g.X_PG;
+          const Vec3 tcp = X_WG.translation();
+          const Vec3 approach = X_WG.linear().col(2);
+          arrows.push_back(SceneArrow{tcp - 0.08 * approach, tcp, {0.1, 0.75, 0.85, 1.0}, 0.006});
+        }
+      }
+    }
+    const double top = s_.doc.project().table.height + 0.001;
+    for (const PlanAction& a : plan.actions) {
+      if (a.type != ActionType::kPlace || a.objects.empty()) continue;
+      for (const PlanObject& o : a.keyframe.objects) {
+        if (o.node != a.objects[0]) continue;
+        Vec3 at = o.X_WA.translation();
+        const auto& tree = s_.viewport.check().tree;
+        if (tree && o.node >= 0 && o.node < static_cast<int>(tree->nodes.size()) &&
+            !tree->nodes[o.node].parts.empty()) {
+          at.setZero();
+          for (int part : tree->nodes[o.node].parts) {
+            at += (o.X_WA * scene.parts[part].X_AP).translation();
+          }
+          at /= static_cast<double>(tree->nodes[o.node].parts.size());
+        }
+        markers.push_back(SceneMarker{Vec3(at.x(), at.y(), top), 0.035, {0.1, 0.6, 0.9, 0.55}});
+      }
+    }
   }
 
   /// The scene at the timeline's time, or the initial scene without a plan of this cell.
@@ -560,9 +611,19 @@ int RunGui(const GuiOptions& options, std::ostream& out, std::ostream& err) {
       q.seed = s.doc.project().planner.seed;
       s.job.Start(s.doc.project(), s.doc.ResolvePath(), q);
       // Frames keep drawing while the worker plans (the window stays responsive).
-      while (s.job.running()) app.Frame(nullptr);
+      int frames = 0;
+      const auto start = std::chrono::steady_clock::now();
+      while (s.job.running()) {
+        app.Frame(nullptr);
+        ++frames;
+      }
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       app.TakePlan();
       const JobProgress prog = s.job.progress();
+      out << "Planner " << ToString(prog.state) << " in " << seconds << " s; the window drew "
+          << frames << " frames meanwhile (" << (seconds > 0 ? frames / seconds : 0.0)
+          << " per second)\n";
       if (prog.state != JobState::kSolved) {
         err << "wrap: planner: " << ToString(prog.state)
             << (prog.error.empty() ? "" : ": " + prog.error) << "\n";

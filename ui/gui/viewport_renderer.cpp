@@ -157,15 +157,27 @@ void ViewportRenderer::Draw(int x, int y, int width, int height) {
         }
       }
     }
-    if (arrow_ && s.mjscene.ngeom < s.mjscene.maxgeom) {
+    for (const SceneArrow& arrow : arrows_) {
+      if (s.mjscene.ngeom >= s.mjscene.maxgeom) break;
       mjvGeom* geom = s.mjscene.geoms + s.mjscene.ngeom;
-      const float rgba[4] = {static_cast<float>(arrow_->color[0]),
-                             static_cast<float>(arrow_->color[1]),
-                             static_cast<float>(arrow_->color[2]), 1.0f};
+      const float rgba[4] = {static_cast<float>(arrow.color[0]), static_cast<float>(arrow.color[1]),
+                             static_cast<float>(arrow.color[2]),
+                             static_cast<float>(arrow.color[3])};
       mjv_initGeom(geom, mjGEOM_ARROW, nullptr, nullptr, nullptr, rgba);
-      mjtNum from[3] = {arrow_->from_W.x(), arrow_->from_W.y(), arrow_->from_W.z()};
-      mjtNum to[3] = {arrow_->to_W.x(), arrow_->to_W.y(), arrow_->to_W.z()};
-      mjv_makeConnector(geom, mjGEOM_ARROW, 0.012, from[0], from[1], from[2], to[0], to[1], to[2]);
+      mjv_makeConnector(geom, mjGEOM_ARROW, arrow.width_m, arrow.from_W.x(), arrow.from_W.y(),
+                        arrow.from_W.z(), arrow.to_W.x(), arrow.to_W.y(), arrow.to_W.z());
+      geom->category = mjCAT_DECOR;
+      s.mjscene.ngeom++;
+    }
+    for (const SceneMarker& marker : markers_) {
+      if (s.mjscene.ngeom >= s.mjscene.maxgeom) break;
+      mjvGeom* geom = s.mjscene.geoms + s.mjscene.ngeom;
+      const float rgba[4] = {
+          static_cast<float>(marker.color[0]), static_cast<float>(marker.color[1]),
+          static_cast<float>(marker.color[2]), static_cast<float>(marker.color[3])};
+      const mjtNum size[3] = {marker.radius_m, marker.radius_m, 0.001};
+      const mjtNum pos[3] = {marker.at_W.x(), marker.at_W.y(), marker.at_W.z()};
+      mjv_initGeom(geom, mjGEOM_CYLINDER, size, pos, nullptr, rgba);
       geom->category = mjCAT_DECOR;
       s.mjscene.ngeom++;
     }

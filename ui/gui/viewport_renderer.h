@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/result.h"
 #include "model/project.h"
@@ -19,9 +20,17 @@ namespace wrap::gui {
 
 /// An arrow drawn into the scene (e.g. the insertion axis of the selected step).
 struct SceneArrow {
-  Vec3 from_W = Vec3::Zero();  ///< Tail, world [m].
-  Vec3 to_W = Vec3::Zero();    ///< Head, world [m].
-  Rgba color = {0.95, 0.2, 0.15, 1.0};
+  Vec3 from_W = Vec3::Zero();           ///< Tail, world [m].
+  Vec3 to_W = Vec3::Zero();             ///< Head, world [m].
+  Rgba color = {0.95, 0.2, 0.15, 1.0};  ///< Colour.
+  double width_m = 0.012;               ///< Shaft width [m].
+};
+
+/// A flat disc lying on the table (e.g. where the plan sets an object down).
+struct SceneMarker {
+  Vec3 at_W = Vec3::Zero();           ///< Centre, world [m].
+  double radius_m = 0.03;             ///< [m].
+  Rgba color = {0.1, 0.6, 0.9, 0.6};  ///< Colour (translucent).
 };
 
 /// The cell of the document, compiled and drawn in the viewport.
@@ -51,8 +60,10 @@ class ViewportRenderer {
   int Pick(double rel_x, double rel_y) const;
   /// Highlights a part (index into the scene's parts; -1: none).
   void set_selected_part(int part) { selected_part_ = part; }
-  /// Draws an arrow (absent: none).
-  void set_arrow(std::optional<SceneArrow> arrow) { arrow_ = arrow; }
+  /// Arrows drawn into the scene (insertion axis, grasps).
+  void set_arrows(std::vector<SceneArrow> arrows) { arrows_ = std::move(arrows); }
+  /// Discs drawn on the table (placements).
+  void set_markers(std::vector<SceneMarker> markers) { markers_ = std::move(markers); }
 
   /// Mouse camera moves, in fractions of the viewport height.
   void Orbit(double dx, double dy);
@@ -67,7 +78,8 @@ class ViewportRenderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   int selected_part_ = -1;
-  std::optional<SceneArrow> arrow_;
+  std::vector<SceneArrow> arrows_;
+  std::vector<SceneMarker> markers_;
 };
 
 }  // namespace wrap::gui
