@@ -52,7 +52,11 @@ int Sim(const SimArgs& args, std::ostream& out, std::ostream& err) {
   options.mjcf_dir = args.mjcf_dir;
   RunContext ctx;
   auto report = SimulatePlan(*loaded.project, loaded.check, args.project, *plan, options, ctx);
-  if (!report) return Report(report.error(), err);
+  if (!report) {
+    Error e = report.error();
+    if (e.code == ErrorCode::kInvalidInput) e.message = args.plan + ": " + e.message;
+    return Report(e, err);
+  }
   if (!args.output.empty()) {
     if (auto ok = WriteFileAtomic(args.output, SerializeSimReport(*report)); !ok) {
       return Report(ok.error(), err);

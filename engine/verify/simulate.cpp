@@ -601,19 +601,19 @@ Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check
                                const std::filesystem::path& project_file, const Plan& plan,
                                const SimOptions& options, RunContext& ctx) {
   InstallMujocoHandlers();
-  auto bad = [](const std::string& m) { return Fail(ErrorCode::kInvalidInput, "sim: " + m); };
-  if (!check.tree) return bad("the project's assembly DAG is not well formed");
+  auto bad = [](const std::string& m) { return Fail(ErrorCode::kInvalidInput, m); };
+  if (!check.tree) return bad("sim: the project's assembly DAG is not well formed");
   if (!(options.timestep_s > 0.0 && options.timestep_s <= 0.01)) {
-    return bad("timestep must be in (0, 0.01] s");
+    return bad("sim: timestep must be in (0, 0.01] s");
   }
   if (!(options.force_scale >= 0.0) || !std::isfinite(options.force_scale)) {
-    return bad("force scale must be a finite number >= 0");
+    return bad("sim: force scale must be a finite number >= 0");
   }
   auto scene = BuildCellScene(project, check, project_file);
   if (!scene) return std::unexpected(scene.error());
   const AssemblyTree& tree = *check.tree;
   if (plan.trajectories.size() != scene->robots.size()) {
-    return bad("the plan has no trajectories for the cell's " +
+    return bad("trajectories: the plan has none for the cell's " +
                std::to_string(scene->robots.size()) +
                " robots (plan it with motion: 'wrap plan' without --task-only)");
   }

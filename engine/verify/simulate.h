@@ -83,9 +83,10 @@ struct SimReport {
 
 /// Simulates `plan` (with trajectories) of `project` (validated: `check` holds its meshes and
 /// tree; `project_file` resolves URDFs). Fails with kInvalidInput when the plan has no motion or
-/// does not fit the cell, kInternal with MuJoCo's message when MuJoCo raises an error (never
-/// exits), kCancelled when `ctx` stops. A plan that fails in simulation is a SimReport with
-/// success false, not an error.
+/// does not fit the cell (the message starts with the plan's JSON path, e.g. "trajectories: ..."
+/// or "actions[3]: ..."; callers prefix the plan file), kInternal with MuJoCo's message when MuJoCo
+/// raises an error (never exits), kCancelled when `ctx` stops. A plan that fails in simulation is a
+/// SimReport with success false, not an error.
 Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check,
                                const std::filesystem::path& project_file, const Plan& plan,
                                const SimOptions& options, RunContext& ctx);

@@ -132,6 +132,45 @@ TEST(Sim, ReleaseInMidAirFailsWithNoSupport) {
   EXPECT_NE(SerializeSimReport(*report).find("\"reason\": \"no support\""), std::string::npos);
 }
 
+// An insertion pressed against a vacuum gripper sideways: the cube's plan (vacuum grippers
+// only) simulated with the first assembled step's insertion axis turned by 90 degrees, so the
+// mating force pushes across the suction cup, which holds no lateral force while mating.
+TEST(Sim, SidewaysInsertionOnVacuumFailsWithVacuumLimit) {
+  const Planned& p = PlanOnce("cube");
+  ASSERT_TRUE(p.error.empty()) << p.error;
+  const Plan& plan = *p.plan;
+  const AssemblyTree& tree = *p.lp.check.tree;
+  int assemble = -1;
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    const PlanAction& a = plan.actions[i];
+    if (a.type != ActionType::kAssemble) continue;
+    if (assemble < 0 || a.end_s < plan.actions[assemble].end_s) assemble = static_cast<int>(i);
+  }
+  ASSERT_GE(assemble, 0);
+  Project sideways = *p.lp.project;
+  Mating& mating = sideways.steps[tree.nodes[plan.actions[assemble].objects[2]].step].mating;
+  const Vec3 axis = mating.axis.normalized();
+  const Vec3 other = std::abs(axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  mating.axis = axis.cross(other).normalized();
+
+  RunContext ctx(0);
+  auto report = SimulatePlan(sideways, p.lp.check, p.file, plan, SimOptions{}, ctx);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_FALSE(report->success);
+  ASSERT_TRUE(report->failure.has_value());
+  EXPECT_EQ(report->failure->reason, "vacuum limit") << report->failure->detail;
+  EXPECT_EQ(report->failure->action, assemble) << report->failure->detail;
+  EXPECT_GT(report->peak.vacuum_insertion, 1.0);
+
+  // The same plan with the project's own axis holds through that insertion.
+  RunContext ctx2(0);
+  auto nominal = SimulatePlan(*p.lp.project, p.lp.check, p.file, plan, SimOptions{}, ctx2);
+  ASSERT_TRUE(nominal) << nominal.error().message;
+  EXPECT_TRUE(nominal->success) << nominal->failure->reason << " at action "
+                                << nominal->failure->action << ": " << nominal->failure->detail;
+  EXPECT_LE(nominal->peak.vacuum_insertion, 1.0);
+}
+
 TEST(Sim, PlanWithoutMotionIsBadInput) {
   const Planned& p = PlanOnce("half_stool");
   ASSERT_TRUE(p.error.empty()) << p.error;
