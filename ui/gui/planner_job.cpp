@@ -1,5 +1,9 @@
 #include "gui/planner_job.h"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <exception>
 
 #include "core/run_context.h"
@@ -100,6 +104,10 @@ void PlannerJob::Finish(JobState state, std::string error, std::shared_ptr<const
 // The catch barrier of the worker: whatever happens inside ends as a state and a message.
 void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::path file,
                      PlannerRequest request) {
+  // The GUI thread draws while this one plans: on a machine with few cores, planning at a lower
+  // priority keeps the window responsive (Linux: nice is per thread; threads this one starts,
+  // e.g. the parallel grasp sampling, inherit it).
+  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 5);
   try {
     RunContext ctx(request.seed);
     ctx.set_stop_token(stop);
