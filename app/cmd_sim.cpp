@@ -68,7 +68,8 @@ int Sim(const SimArgs& args, std::ostream& out, std::ostream& err) {
       << report->tasks_total << " actions, " << Fmt("%.2f", report->simulated_s) << " s simulated\n"
       << "peak utilisation: transport 2F " << Percent(u.two_finger_transport) << ", vacuum "
       << Percent(u.vacuum_transport) << "; insertion 2F " << Percent(u.two_finger_insertion)
-      << ", vacuum " << Percent(u.vacuum_insertion) << "\n";
+      << ", vacuum " << Percent(u.vacuum_insertion) << "; connections " << Percent(u.connection)
+      << "\n";
   if (report->failure) {
     const SimFailure& f = *report->failure;
     out << "failure: action " << f.action;

@@ -36,7 +36,8 @@ std::string SerializeSimReport(const SimReport& report) {
                                      {"vacuum", Percent(report.peak.vacuum_transport)}}},
                                    {"insertion",
                                     {{"two_finger", Percent(report.peak.two_finger_insertion)},
-                                     {"vacuum", Percent(report.peak.vacuum_insertion)}}}};
+                                     {"vacuum", Percent(report.peak.vacuum_insertion)}}},
+                                   {"connection", Percent(report.peak.connection)}};
   Json actions = Json::array();
   for (size_t i = 0; i < report.actions.size(); ++i) {
     const SimActionStatus& a = report.actions[i];

@@ -36,7 +36,21 @@ struct Interface {
   Vec3 axis_A = Vec3::UnitZ();
   double force_N = 0.0;
   double torque_Nm = 0.0;
+  WrenchBox limits;  // T_pq of the connection, in its frame C
 };
+
+// The connection frame C in A: origin at the interface, z along the axis (as task/world.cpp).
+Iso3 ConnectionFrame(const Vec3& origin, const Vec3& z_axis) {
+  const Vec3 z = z_axis.normalized();
+  const Vec3 helper = std::abs(z.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  const Vec3 x = (helper - helper.dot(z) * z).normalized();
+  Iso3 X = Iso3::Identity();
+  X.linear().col(0) = x;
+  X.linear().col(1) = z.cross(x);
+  X.linear().col(2) = z;
+  X.translation() = origin;
+  return X;
+}
 
 Aabb PartBoxInA(const ScenePart& part) {
   Aabb box;
@@ -201,8 +215,10 @@ class Simulator {
       const PlanAction& a = plan_.actions[i];
       if (a.type != ActionType::kAssemble) continue;
       const int step = tree_.nodes[a.objects[2]].step;
-      interfaces_[static_cast<int>(i)] =
-          FindInterface(scene_, tree_, project_.steps[step].mating, a.objects[0], a.objects[1]);
+      const Mating& mating = project_.steps[step].mating;
+      Interface in = FindInterface(scene_, tree_, mating, a.objects[0], a.objects[1]);
+      in.limits = mating.connection_limits.value_or(project_.connection_limits);
+      interfaces_[static_cast<int>(i)] = in;
     }
     order_.resize(plan_.actions.size());
     for (size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<int>(i);
@@ -357,6 +373,7 @@ class Simulator {
         const int p = std::min(in.part_moved, in.part_base);
         const int q = std::max(in.part_moved, in.part_base);
         Weld(join_eq_[p][q], PartPose(p), PartPose(q));
+        joins_.push_back({join_eq_[p][q], q, i});
         Object merged = objects_[a.objects[1]];
         for (int r : objects_[a.objects[0]].holders) merged.holders.push_back(r);
         std::sort(merged.holders.begin(), merged.holders.end());
@@ -409,12 +426,10 @@ class Simulator {
     }
   }
 
-  // The wrench robot r's weld exerts on its part, in the TCP (grasp) frame about its origin.
-  void GripWrench(int r, Vec3& f_G, Vec3& tau_G) const {
+  // The wrench weld `eq` exerts on part p: world force, and world torque about the part's origin.
+  void WeldWrench(int eq, int p, Vec3& f_W, Vec3& tau_W) const {
     const mjModel* m = model_.get();
     const mjData* d = data_.get();
-    const int p = grip_part_[r];
-    const int eq = grip_eq_[r][p];
     const int dof = part_dof_[p];
     double gen[6] = {0, 0, 0, 0, 0, 0};
     int rows = 0;
@@ -425,13 +440,35 @@ class Simulator {
     }
     // A free joint's generalised force: world force, then torque in the body frame about its
     // origin (the part frame).
-    const Iso3 X_WP = PartPose(p);
+    f_W = Vec3(gen[0], gen[1], gen[2]);
+    tau_W = PartPose(p).linear() * Vec3(gen[3], gen[4], gen[5]);
+  }
+
+  // The wrench robot r's weld exerts on its part, in the TCP (grasp) frame about its origin.
+  void GripWrench(int r, Vec3& f_G, Vec3& tau_G) const {
+    const int p = grip_part_[r];
+    Vec3 f_W, tau_W;
+    WeldWrench(grip_eq_[r][p], p, f_W, tau_W);
     const Iso3 X_WG = TcpBodyPose(r);
-    const Vec3 f_W(gen[0], gen[1], gen[2]);
-    const Vec3 tau_W = X_WP.linear() * Vec3(gen[3], gen[4], gen[5]) +
-                       (X_WP.translation() - X_WG.translation()).cross(f_W);
+    tau_W += (PartPose(p).translation() - X_WG.translation()).cross(f_W);
     f_G = X_WG.linear().transpose() * f_W;
     tau_G = X_WG.linear().transpose() * tau_W;
+  }
+
+  // Every made connection against its limits, in its connection frame.
+  void MeasureConnections() {
+    for (const Join& j : joins_) {
+      const Interface& in = interfaces_.at(j.action);
+      Vec3 f_W, tau_W;
+      WeldWrench(j.eq, j.part, f_W, tau_W);
+      const Iso3 X_WA = PartPose(in.part_base) * scene_.parts[in.part_base].X_AP.inverse();
+      const Iso3 X_WC = X_WA * ConnectionFrame(in.p_A, in.axis_A);
+      tau_W += (PartPose(j.part).translation() - X_WC.translation()).cross(f_W);
+      const double u =
+          BoxUtilisation(X_WC.linear().transpose() * f_W, X_WC.linear().transpose() * tau_W,
+                         in.limits, options_.zero_limit_force_N, options_.zero_limit_torque_Nm);
+      report_.peak.connection = std::max(report_.peak.connection, u);
+    }
   }
 
   void Measure(double t, const std::vector<int>& inserting) {
@@ -492,6 +529,7 @@ class Simulator {
         return;
       }
     }
+    MeasureConnections();
     // Every part where the plan has it.
     for (const auto& [node, o] : objects_) {
       const Iso3 X_WA = ExpectedX_WA(o);
@@ -589,8 +627,14 @@ class Simulator {
   std::vector<Vec3> hold_f_, hold_tau_;    // per robot, wrench when its insertion began
   std::vector<bool> was_inserting_;        // per robot
   std::map<int, Interface> interfaces_;    // per assemble action
-  std::map<int, Object> objects_;          // by node id
-  std::vector<int> order_;                 // actions by end_s
+  struct Join {
+    int eq = -1;      // weld id
+    int part = -1;    // its body2
+    int action = -1;  // the assemble that made it
+  };
+  std::vector<Join> joins_;        // connections made so far
+  std::map<int, Object> objects_;  // by node id
+  std::vector<int> order_;         // actions by end_s
   size_t next_event_ = 0;
   double makespan_ = 0.0;
 };

@@ -48,6 +48,10 @@ struct SimUtilisation {
   double two_finger_insertion = -1.0;  ///< Two-finger grippers during insertions.
   double vacuum_transport = -1.0;      ///< Vacuum grippers carrying or holding.
   double vacuum_insertion = -1.0;      ///< Vacuum grippers during insertions.
+  /// Made connections: the wrench through the weld of each made connection against its limits
+  /// (T_pq, a box in the connection frame: origin at the interface, z along the insertion axis).
+  /// Reported, not a failure.
+  double connection = -1.0;
 };
 
 /// What happened to one action of the plan.

@@ -85,6 +85,9 @@ TEST(Sim, FullModelPlanHolds) {
   EXPECT_LE(peak_transport, 1.0);
   EXPECT_LE(std::max(u.two_finger_insertion, u.vacuum_insertion), 1.0);
   EXPECT_LT(report->final_position_error_m, SimOptions{}.misalign_tolerance_m);
+  // Connections were made and held within their limits.
+  EXPECT_GE(u.connection, 0.0);
+  EXPECT_LE(u.connection, 1.0);
   // The report as JSON says the same.
   const std::string json = SerializeSimReport(*report);
   EXPECT_NE(json.find("\"success\": true"), std::string::npos);
