@@ -174,6 +174,46 @@ TEST(Sim, SidewaysInsertionOnVacuumFailsWithVacuumLimit) {
   EXPECT_LE(nominal->peak.vacuum_insertion, 1.0);
 }
 
+// A moved part that does not meet its base where the assembly has it: the project's assembled
+// pose of the first assemble's moved part is shifted 2 cm across the insertion axis after
+// planning, so the plan mates it off by that much.
+TEST(Sim, OffsetMatingFailsWithMisalignment) {
+  const Planned& p = PlanOnce("half_stool");
+  ASSERT_TRUE(p.error.empty()) << p.error;
+  const Plan& plan = *p.plan;
+  const AssemblyTree& tree = *p.lp.check.tree;
+  int assemble = -1;
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    const PlanAction& a = plan.actions[i];
+    if (a.type != ActionType::kAssemble) continue;
+    if (assemble < 0 || a.end_s < plan.actions[assemble].end_s) assemble = static_cast<int>(i);
+  }
+  ASSERT_GE(assemble, 0);
+  const int moved = plan.actions[assemble].objects[0];
+  ASSERT_EQ(tree.nodes[moved].parts.size(), 1u) << "expected a single part moved first";
+  Project shifted = *p.lp.project;
+  Part& part = shifted.parts[tree.nodes[moved].parts.front()];
+  const Mating& mating = shifted.steps[tree.nodes[plan.actions[assemble].objects[2]].step].mating;
+  const Vec3 axis = mating.axis.normalized();
+  const Vec3 across = axis.cross(std::abs(axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY());
+  const Iso3 X_AP = ToIsometry(part.assembled_pose);
+  part.assembled_pose.xyz += 0.02 * across.normalized();
+  // The part starts where it did (the plan's initial objects are frames A, parts sit at
+  // X_WA X_AP): only where the assembly wants it differs.
+  Plan same_start = plan;
+  for (PlanObject& o : same_start.initial.objects) {
+    if (o.node == moved) o.X_WA = o.X_WA * X_AP * ToIsometry(part.assembled_pose).inverse();
+  }
+
+  RunContext ctx(0);
+  auto report = SimulatePlan(shifted, p.lp.check, p.file, same_start, SimOptions{}, ctx);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_FALSE(report->success);
+  ASSERT_TRUE(report->failure.has_value());
+  EXPECT_EQ(report->failure->reason, "misalignment") << report->failure->detail;
+  EXPECT_EQ(report->failure->action, assemble) << report->failure->detail;
+}
+
 TEST(Sim, PlanWithoutMotionIsBadInput) {
   const Planned& p = PlanOnce("half_stool");
   ASSERT_TRUE(p.error.empty()) << p.error;
