@@ -27,8 +27,10 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   validate->add_option("PROJECT", project, "Project file (.json)")->required();
   validate->add_flag("-q,--quiet", quiet, "Print errors only, not warnings or the summary");
   std::string validate_plan;
-  validate->add_option("--plan", validate_plan,
-                       "Also replay this plan (JSON) with the independent plan validator");
+  validate->add_option(
+      "--plan", validate_plan,
+      "Also replay this plan (JSON) with the independent plan validator (and, for a plan "
+      "with motion, the trajectory check)");
 
   CLI::App* info = app.add_subcommand(
       "info", "Describe a project: parts, the assembly DAG, robots and end effectors");

@@ -10,6 +10,7 @@
 namespace wrap {
 struct LoadedProject;
 struct Plan;
+struct Preprocessed;
 }  // namespace wrap
 
 namespace wrap::cli {
@@ -31,6 +32,11 @@ int Validate(const std::string& project, const std::string& plan, bool quiet, st
 
 int ReportPlanValidation(const LoadedProject& loaded, const Plan& plan, const std::string& project,
                          std::ostream& out, std::ostream& err);
+
+/// Checks the trajectories of a plan with motion densely (motion/trajectory_check) and prints the
+/// verdict like ReportPlanValidation. `pre`: the project's preprocessing, or null to run it.
+int ReportTrajectoryCheck(const LoadedProject& loaded, const Plan& plan, const std::string& project,
+                          const Preprocessed* pre, std::ostream& out, std::ostream& err);
 
 /// `wrap info PROJECT`: parts with mass and size, the DAG as a tree, robots and end effectors.
 int Info(const std::string& project, std::ostream& out, std::ostream& err);

@@ -1,4 +1,5 @@
 #include <cstdio>
+#include <optional>
 #include <ostream>
 
 #include "cli.h"
@@ -36,6 +37,47 @@ int ReportPlanValidation(const LoadedProject& loaded, const Plan& plan, const st
   out << "Validated: " << v->actions << " actions, " << v->keyframes << " keyframes, "
       << v->collision_checks << " collision queries, " << v->wrench_checks
       << " wrench gates re-solved\n";
+  return 0;
+}
+
+int ReportTrajectoryCheck(const LoadedProject& loaded, const Plan& plan, const std::string& project,
+                          const Preprocessed* pre, std::ostream& out, std::ostream& err) {
+  std::optional<Preprocessed> own;
+  if (pre == nullptr) {
+    RunContext ctx(plan.stats.seed);
+    PreprocessOptions pre_options;
+    pre_options.project_file = project;
+    auto made = wrap::Preprocess(*loaded.project, loaded.check, pre_options, ctx);
+    if (!made) {
+      err << project << ": " << made.error().message << "\n";
+      return ExitCodeFor(made.error().code);
+    }
+    own = std::move(*made);
+    pre = &*own;
+  }
+  auto world = BuildTaskWorld(*loaded.project, loaded.check, *pre, project);
+  if (!world) {
+    err << project << ": " << world.error().message << "\n";
+    return ExitCodeFor(world.error().code);
+  }
+  TrajectoryCheckOptions topt;
+  auto check = CheckTrajectories(*world, plan, topt);
+  if (!check) {
+    err << "trajectory check: " << check.error().message << "\n";
+    return ExitCodeFor(check.error().code);
+  }
+  if (!check->valid) {
+    err << "Trajectory check FAILED: " << check->issues.size() << " issue(s)\n";
+    for (const TrajectoryIssue& issue : check->issues) {
+      err << "  " << FormatTrajectoryIssue(plan, issue) << "\n";
+    }
+    return 1;
+  }
+  out << "Trajectories checked: " << check->samples << " moments at "
+      << Fmt("%g", topt.resolution_rad) << " rad joint resolution, limits (peak "
+      << Fmt("%.0f", 100 * check->max_velocity_ratio) << "% of velocity, "
+      << Fmt("%.0f", 100 * check->max_acceleration_ratio)
+      << "% of acceleration), events and grasps: no issue\n";
   return 0;
 }
 
@@ -140,30 +182,7 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
     return code;
   }
   if (!st.motion) return 0;
-  auto world = BuildTaskWorld(p, loaded.check, *pre, args.project);
-  if (!world) {
-    err << args.project << ": " << world.error().message << "\n";
-    return ExitCodeFor(world.error().code);
-  }
-  TrajectoryCheckOptions topt;
-  auto check = CheckTrajectories(*world, *plan, topt);
-  if (!check) {
-    err << "trajectory check: " << check.error().message << "\n";
-    return ExitCodeFor(check.error().code);
-  }
-  if (!check->valid) {
-    err << "Trajectory check FAILED: " << check->issues.size() << " issue(s)\n";
-    for (const TrajectoryIssue& issue : check->issues) {
-      err << "  " << FormatTrajectoryIssue(*plan, issue) << "\n";
-    }
-    return 1;
-  }
-  out << "Trajectories checked: " << check->samples << " moments at "
-      << Fmt("%g", topt.resolution_rad) << " rad joint resolution, limits (peak "
-      << Fmt("%.0f", 100 * check->max_velocity_ratio) << "% of velocity, "
-      << Fmt("%.0f", 100 * check->max_acceleration_ratio)
-      << "% of acceleration), events and grasps: no issue\n";
-  return 0;
+  return ReportTrajectoryCheck(loaded, *plan, args.project, &*pre, out, err);
 }
 
 }  // namespace wrap::cli

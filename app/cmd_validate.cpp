@@ -55,7 +55,11 @@ int Validate(const std::string& project, const std::string& plan_file, bool quie
     err << ok.error().message << "\n";
     return 2;
   }
-  return ReportPlanValidation(loaded, *plan, project, out, err);
+  if (const int code = ReportPlanValidation(loaded, *plan, project, out, err); code != 0) {
+    return code;
+  }
+  if (!plan->stats.motion) return 0;
+  return ReportTrajectoryCheck(loaded, *plan, project, nullptr, out, err);
 }
 
 }  // namespace wrap::cli

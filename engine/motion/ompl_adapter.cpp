@@ -10,6 +10,7 @@
 #include <ompl/base/ProblemDefinition.h>
 #include <ompl/base/ScopedState.h>
 #include <ompl/base/SpaceInformation.h>
+#include <ompl/base/goals/GoalStates.h>
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/datastructures/NearestNeighborsLinear.h>
 #include <ompl/geometric/PathGeometric.h>
@@ -175,17 +176,30 @@ PathAnswer PlanPath(const PathQuery& query) {
     return out;
   }
   ++out.checks;
-  if (!query.valid(query.goal)) {
+  // The goals that are free (the given one first).
+  std::vector<Eigen::VectorXd> goals;
+  std::vector<int> goal_ids;
+  for (size_t k = 0; k <= query.other_goals.size(); ++k) {
+    const Eigen::VectorXd& g = k == 0 ? query.goal : query.other_goals[k - 1];
+    ++out.checks;
+    if (query.valid(g)) {
+      goals.push_back(g);
+      goal_ids.push_back(static_cast<int>(k));
+    }
+  }
+  if (goals.empty()) {
     out.why = "the goal configuration is in collision";
     return out;
   }
-  ++out.checks;
   PathQuery fine = query;
   if (query.final_resolution > 0.0) fine.resolution = query.final_resolution;
-  if (StraightMotionValid(fine, query.start, query.goal, &out.checks)) {
-    out.solved = true;
-    out.path = {query.start, query.goal};
-    return out;
+  for (size_t k = 0; k < goals.size(); ++k) {
+    if (StraightMotionValid(fine, query.start, goals[k], &out.checks)) {
+      out.solved = true;
+      out.path = {query.start, goals[k]};
+      out.goal_index = goal_ids[k];
+      return out;
+    }
   }
   ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
   auto space = std::make_shared<ob::RealVectorStateSpace>(dim);
@@ -207,13 +221,16 @@ PathAnswer PlanPath(const PathQuery& query) {
   si->setMotionValidator(std::make_shared<DenseMotionValidator>(si, query, dim, &out.checks));
   si->setup();
   ob::ScopedState<> start(space);
-  ob::ScopedState<> goal(space);
-  for (int i = 0; i < dim; ++i) {
-    start[i] = query.start[i];
-    goal[i] = query.goal[i];
+  for (int i = 0; i < dim; ++i) start[i] = query.start[i];
+  auto goal_states = std::make_shared<ob::GoalStates>(si);
+  for (const Eigen::VectorXd& g : goals) {
+    ob::ScopedState<> goal(space);
+    for (int i = 0; i < dim; ++i) goal[i] = g[i];
+    goal_states->addState(goal);
   }
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
-  pdef->setStartAndGoalStates(start, goal);
+  pdef->addStartState(start);
+  pdef->setGoal(goal_states);
   auto planner = std::make_shared<og::RRTConnect>(si);
   planner->setNearestNeighbors<ompl::NearestNeighborsLinear>();
   // Short extensions: a long one through clutter is nearly always trapped.
@@ -241,7 +258,15 @@ PathAnswer PlanPath(const PathQuery& query) {
       out.path.push_back(ToVector(path->getState(i), dim));
     }
     out.path.front() = query.start;
-    out.path.back() = query.goal;
+    size_t reached = 0;
+    for (size_t k = 1; k < goals.size(); ++k) {
+      if ((goals[k] - out.path.back()).squaredNorm() <
+          (goals[reached] - out.path.back()).squaredNorm()) {
+        reached = k;
+      }
+    }
+    out.path.back() = goals[reached];
+    out.goal_index = goal_ids[reached];
     if (PathValid(fine, out.path, &out.checks)) break;
     // It grazes something between the states RRT-Connect checked: search again.
     attempt_seed = attempt_seed * 6364136223846793005ULL + 1442695040888963407ULL;

@@ -17,7 +17,10 @@ struct PathQuery {
   Eigen::VectorXd lower;  ///< Lower bound per coordinate [rad or m].
   Eigen::VectorXd upper;  ///< Upper bound per coordinate.
   Eigen::VectorXd start;  ///< Start configuration (must be valid).
-  Eigen::VectorXd goal;   ///< Goal configuration (must be valid).
+  Eigen::VectorXd goal;   ///< Goal configuration.
+  /// Other configurations that serve as well as `goal` (e.g. other IK solutions of the same
+  /// TCP pose); the path ends at whichever it reaches. The bounds must hold them.
+  std::vector<Eigen::VectorXd> other_goals;
   /// State validity (collision-free); called from the planner's thread only.
   std::function<bool(const Eigen::VectorXd&)> valid;
   /// Motions are checked at states no farther apart than this in any coordinate [rad or m].
@@ -39,8 +42,10 @@ struct PathAnswer {
   bool solved = false;                ///< A path was found.
   bool timed_out = false;             ///< Not solved within the budget (more effort may help).
   std::vector<Eigen::VectorXd> path;  ///< Waypoints from start to goal (solved only).
-  long long checks = 0;               ///< State validity checks.
-  std::string why;                    ///< When not solved: why, in words.
+  /// The goal reached: 0 for `goal`, k for `other_goals[k - 1]` (solved only).
+  int goal_index = 0;
+  long long checks = 0;  ///< State validity checks.
+  std::string why;       ///< When not solved: why, in words.
 };
 
 /// True when the straight motion from a to b is valid at the query's resolution (both ends

@@ -32,6 +32,9 @@ constexpr double kMaxSnap = 0.05;
 // that the dense check of the timed motion, sampling other points of the same straight pieces
 // at the resolution, meets no grazing contact that the planner's samples stepped over.
 constexpr int kRefine = 4;
+// Joint perturbation and sample count of the tight-pocket test [rad].
+constexpr double kTightRad = 0.03;
+constexpr int kTightSamples = 16;
 // Least distance between two robots at a keyframe, as the task planner keeps it [m].
 constexpr double kMinClearance = 0.005;
 
@@ -114,9 +117,15 @@ class Builder {
   // Backs robot r's TCP away from q along its approach axis (TCP z) by up to approach_m,
   // collision-free in the current scene; the waypoints from q outwards, or empty.
   std::vector<JointVector> BackOff(int robot, const JointVector& q, double* length);
+  // Whether robot r at q is in a tight pocket: more than one in eight small perturbations of its
+  // joints (kTightRad) collide in the current scene.
+  bool Tight(int robot, const JointVector& q);
   bool Retreat(int action, int robot);
+  // Free motion of `robots` to `goals`. With `others` (one robot only): other goals that serve
+  // as well; *reached tells which was reached (0: goals[0], k: others[k - 1]).
   bool Free(int action, bool main, const std::vector<int>& robots,
-            const std::vector<JointVector>& goals, const std::vector<int>& objects);
+            const std::vector<JointVector>& goals, const std::vector<int>& objects,
+            const std::vector<JointVector>* others = nullptr, int* reached = nullptr);
   bool Lift(int action, int node, const std::vector<int>& holders);
   bool Carry(int action, int node, const std::vector<int>& holders, const Iso3& X_goal,
              std::vector<JointVector> goal_q, const Keyframe& target, bool approach);
@@ -129,6 +138,10 @@ class Builder {
   // Moves robot r from `old_q` to `new_q` at action `action`'s approach keyframe (when
   // `from_approach`) or keyframe and at every following keyframe where it kept `old_q`.
   void Rebranch(int robot, int action, bool from_approach, JointVector old_q, JointVector new_q);
+  // Whether every keyframe that Rebranch(robot, action, from_approach, old_q, new_q) would
+  // rewrite accepts new_q (KeyframeAccepts in the state before its action).
+  bool StageAccepts(int robot, int action, bool from_approach, const JointVector& old_q,
+                    const JointVector& new_q);
 
   const TaskWorld& w_;
   Plan& plan_;
@@ -359,11 +372,47 @@ bool Builder::PathClear(const std::vector<int>& robots,
   return true;
 }
 
+bool Builder::Tight(int robot, const JointVector& q) {
+  // A few small joint perturbations, the same every time.
+  std::mt19937_64 g(0x7469676874);
+  std::uniform_real_distribution<double> u(-kTightRad, kTightRad);
+  int bad = 0;
+  for (int t = 0; t < kTightSamples; ++t) {
+    JointVector x = q;
+    for (int j = 0; j < x.size(); ++j) x[j] += u(g);
+    scene_.SetRobot(robot, x);
+    bad += scene_.Collides(std::span<const int>(&robot, 1));
+  }
+  scene_.SetRobot(robot, q);
+  return bad > kTightSamples / 8;
+}
+
 std::vector<JointVector> Builder::BackOff(int robot, const JointVector& q, double* length) {
   const Iso3 X0 = Tcp(robot, q);
   const Vec3 axis = X0.linear().col(2);
-  for (double d :
-       {opt_.approach_m, opt_.approach_m / 2, opt_.approach_m / 4, opt_.approach_m / 8}) {
+  // Longer first where the end of the usual length is in a tight pocket (free path searches
+  // hardly leave one); then the usual length and shorter ones.
+  std::vector<std::vector<JointVector>> longer;
+  for (double d : {opt_.approach_m, 2 * opt_.approach_m, 3 * opt_.approach_m}) {
+    const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
+    auto target = [X0, axis, d](double s) {
+      Iso3 X = X0;
+      X.translation() -= s * d * axis;
+      return X;
+    };
+    auto path = Track({robot}, {q}, {target}, steps);
+    if (path.empty() || !PathClear({robot}, path)) break;
+    std::vector<JointVector> out;
+    for (auto& wp : path) out.push_back(wp[0]);
+    *length = d;
+    if (!Tight(robot, out.back()) || d > 2.5 * opt_.approach_m) return out;
+    longer.push_back(std::move(out));
+  }
+  if (!longer.empty()) {
+    *length = opt_.approach_m * static_cast<double>(longer.size());
+    return longer.back();
+  }
+  for (double d : {opt_.approach_m / 2, opt_.approach_m / 4, opt_.approach_m / 8}) {
     const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
     auto target = [X0, axis, d](double s) {
       Iso3 X = X0;
@@ -401,7 +450,10 @@ bool Builder::Retreat(int action, int robot) {
 }
 
 bool Builder::Free(int action, bool main, const std::vector<int>& robots,
-                   const std::vector<JointVector>& goals, const std::vector<int>& objects) {
+                   const std::vector<JointVector>& goals, const std::vector<int>& objects,
+                   const std::vector<JointVector>* others, int* reached) {
+  if (reached) *reached = 0;
+  if (others && others->empty()) others = nullptr;
   std::vector<int> movers;
   std::vector<JointVector> targets;
   for (size_t i = 0; i < robots.size(); ++i) {
@@ -422,6 +474,7 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
   if (const MotionCache::Path& c = cache_.free_paths[index]; !c.waypoints.empty()) {
     // Reuse a path solved at a lower effort when it is the same query.
     bool same = true;
+    int end = 0;
     for (size_t i = 0; i < movers.size() && same; ++i) {
       const auto it = std::find(c.robots.begin(), c.robots.end(), movers[i]);
       same = it != c.robots.end();
@@ -429,9 +482,20 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
         const size_t j = static_cast<size_t>(it - c.robots.begin());
         same = Same(c.waypoints.front()[j], cur_[movers[i]]) &&
                Same(c.waypoints.back()[j], targets[i]);
+        if (!same && others && movers.size() == 1 &&
+            Same(c.waypoints.front()[j], cur_[movers[i]])) {
+          for (size_t k = 0; k < others->size() && !same; ++k) {
+            same = Same(c.waypoints.back()[j], (*others)[k]);
+            end = static_cast<int>(k) + 1;
+          }
+        }
       }
     }
     if (same) {
+      if (std::getenv("WRAP_MOTION_DEBUG")) {
+        std::fprintf(stderr, "[free] action %d: reused path %d\n", action + 1, index);
+      }
+      if (reached) *reached = end;
       seg.robots = c.robots;
       seg.waypoints = c.waypoints;
       Push(std::move(seg));
@@ -462,6 +526,13 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
         query.upper[k] = std::min(chain.joints[j].upper, hi);
       }
     }
+    if (others && who.size() == 1) {
+      for (const JointVector& g : *others) {
+        query.other_goals.push_back(g);
+        query.lower = query.lower.cwiseMin(g);
+        query.upper = query.upper.cwiseMax(g);
+      }
+    }
     auto split = [&](const Eigen::VectorXd& x) {
       std::vector<JointVector> qs(who.size());
       int o = 0;
@@ -485,11 +556,22 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
     const auto t_query = std::chrono::steady_clock::now();
     query.final_resolution = query.resolution / kRefine;
     const PathAnswer answer = PlanPath(query);
+    std::string hit;
+    if (std::getenv("WRAP_MOTION_DEBUG") && !answer.solved && !answer.timed_out) {
+      for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], to[i]);
+      CollisionResult res;
+      if (scene_.cell().InCollision(&res)) {
+        const CollisionWorld& cw = scene_.cell().world();
+        hit = " ('" + cw.body_name(res.first.body_a) + "' hits '" + cw.body_name(res.first.body_b) +
+              "')";
+      }
+    }
     for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], cur_[who[i]]);
     if (std::getenv("WRAP_MOTION_DEBUG")) {
       std::fprintf(
-          stderr, "[free] action %d robots %zu: %s, %lld checks, %.2f s, %zu waypoints\n",
-          action + 1, who.size(), answer.solved ? "solved" : answer.why.c_str(), answer.checks,
+          stderr, "[free] action %d robots %zu: %s%s, %lld checks, %.2f s, %zu waypoints\n",
+          action + 1, who.size(), answer.solved ? "solved" : answer.why.c_str(), hit.c_str(),
+          answer.checks,
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t_query).count(),
           answer.path.size());
     }
@@ -500,6 +582,7 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
   };
   std::vector<std::vector<JointVector>> path;
   PathAnswer answer = plan(movers, targets, &path);
+  if (answer.solved && reached) *reached = answer.goal_index;
   std::vector<int> who = movers;
   if (!answer.solved && answer.timed_out && effort_ > 0 && !ctx_.ShouldStop()) {
     // The idle robots (free, not in this segment) may step aside and come back.
@@ -697,6 +780,26 @@ bool Builder::KeyframeAccepts(int robot, const JointVector& q, const Keyframe& k
   return scene_.cell().MinRobotClearance(request).distance >= kMinClearance;
 }
 
+bool Builder::StageAccepts(int robot, int action, bool from_approach, const JointVector& old_q,
+                           const JointVector& new_q) {
+  const PlanState saved = state_;
+  bool ok = true;
+  for (size_t j = static_cast<size_t>(action); ok && j < plan_.actions.size(); ++j) {
+    const PlanAction& b = plan_.actions[j];
+    state_ = states_[j];
+    if (b.approach && (from_approach || j > static_cast<size_t>(action))) {
+      if (!Same(b.approach->q[robot], old_q)) break;
+      ok = KeyframeAccepts(robot, new_q, *b.approach, {});
+    }
+    if (!ok || !Same(b.keyframe.q[robot], old_q)) break;
+    std::vector<std::pair<int, int>> mating;
+    if (b.type == ActionType::kAssemble) mating.push_back({b.objects[0], b.objects[1]});
+    ok = KeyframeAccepts(robot, new_q, b.keyframe, mating);
+  }
+  state_ = saved;
+  return ok;
+}
+
 void Builder::Rebranch(int robot, int action, bool from_approach, JointVector old_q,
                        JointVector new_q) {
   // By value: old_q may be a keyframe's own joints, which this overwrites.
@@ -777,44 +880,77 @@ bool Builder::Action(int i) {
   // The approach of each grasper, planned backwards from its grasp.
   std::vector<std::vector<JointVector>> approaches(graspers.size());
   std::vector<double> approach_len(graspers.size(), 0.0);
+  // Other IK solutions of each grasper's grasp (UR arms, at higher effort): where they fit the
+  // keyframe and can approach straight, the free path may end at any of them.
+  struct Alternative {
+    JointVector q;
+    std::vector<JointVector> approach;
+    double length = 0.0;
+  };
+  std::vector<std::vector<Alternative>> alternatives(graspers.size());
   for (size_t k = 0; k < graspers.size(); ++k) {
     const int r = graspers[k];
-    std::vector<double> openings = opening_;
-    openings[r] = GraspOpening(w_.robots[r], new_grasp);
-    const JointVector saved = cur_[r];
-    cur_[r] = K.q[r];
-    // The scene at the keyframe's object poses: the object to grasp where it will be.
-    PlanState at = state_;
-    for (const PlanObject& o : K.objects) {
-      if (auto it = at.objects.find(o.node); it != at.objects.end()) it->second.X_WA = o.X_WA;
-    }
-    std::swap(state_, at);
-    std::vector<int> carriers_now;
-    for (const Moving& m : moving) {
-      for (int h : m.holders) {
-        carriers_now.push_back(h);
+    std::vector<JointVector> options = {K.q[r]};
+    const TaskRobot& tr = w_.robots[r];
+    if (effort_ >= 1 && tr.ur) {
+      const UrIkSolutions sols = tr.ur->SolveTcp(tr.X_BW * Tcp(r, K.q[r]), tr.end_effector.X_FT);
+      for (int c = 0; c < sols.count; ++c) {
+        const JointVector q = NearestEquivalent(tr.chain, sols.q[c], cur_[r]);
+        if ((NearestEquivalent(tr.chain, q, K.q[r]) - K.q[r]).cwiseAbs().maxCoeff() < 1e-6) {
+          continue;
+        }
+        if (StageAccepts(r, i, false, K.q[r], q)) options.push_back(q);
+      }
+      if (std::getenv("WRAP_MOTION_DEBUG")) {
+        std::fprintf(stderr, "[alternatives] action %d %s: %d IK solutions, %zu fit\n", i + 1,
+                     Name(r).c_str(), sols.count, options.size() - 1);
       }
     }
-    std::vector<JointVector> saved_carriers;
-    for (int h : carriers_now) {
-      saved_carriers.push_back(cur_[h]);
-      cur_[h] = K.q[h];
+    for (size_t o = 0; o < options.size(); ++o) {
+      std::vector<double> openings = opening_;
+      openings[r] = GraspOpening(w_.robots[r], new_grasp);
+      const JointVector saved = cur_[r];
+      cur_[r] = K.q[r];
+      // The scene at the keyframe's object poses: the object to grasp where it will be.
+      PlanState at = state_;
+      for (const PlanObject& o : K.objects) {
+        if (auto it = at.objects.find(o.node); it != at.objects.end()) it->second.X_WA = o.X_WA;
+      }
+      std::swap(state_, at);
+      std::vector<int> carriers_now;
+      for (const Moving& m : moving) {
+        for (int h : m.holders) {
+          carriers_now.push_back(h);
+        }
+      }
+      std::vector<JointVector> saved_carriers;
+      for (int h : carriers_now) {
+        saved_carriers.push_back(cur_[h]);
+        cur_[h] = K.q[h];
+      }
+      auto set = SetScene(openings, {}, {}, {{r, grasped}});
+      if (!set) return false;
+      double len = 0.0;
+      std::vector<JointVector> back = BackOff(r, options[o], &len);
+      for (size_t c = 0; c < carriers_now.size(); ++c) cur_[carriers_now[c]] = saved_carriers[c];
+      std::swap(state_, at);
+      cur_[r] = saved;
+      if (o > 0) {
+        if (!back.empty()) {
+          std::reverse(back.begin(), back.end());
+          alternatives[k].push_back({options[o], std::move(back), len});
+        }
+        continue;
+      }
+      if (back.empty()) {
+        return Fail(i, SegmentKind::kApproach, false,
+                    Name(r) + " cannot approach its grasp on " + NodeName(grasped) +
+                        " straight along the gripper axis: " + last_hit_);
+      }
+      std::reverse(back.begin(), back.end());
+      approaches[k] = std::move(back);
+      approach_len[k] = len;
     }
-    auto set = SetScene(openings, {}, {}, {{r, grasped}});
-    if (!set) return false;
-    double len = 0.0;
-    std::vector<JointVector> back = BackOff(r, K.q[r], &len);
-    for (size_t c = 0; c < carriers_now.size(); ++c) cur_[carriers_now[c]] = saved_carriers[c];
-    std::swap(state_, at);
-    cur_[r] = saved;
-    if (back.empty()) {
-      return Fail(i, SegmentKind::kApproach, false,
-                  Name(r) + " cannot approach its grasp on " + NodeName(grasped) +
-                      " straight along the gripper axis: " + last_hit_);
-    }
-    std::reverse(back.begin(), back.end());
-    approaches[k] = std::move(back);
-    approach_len[k] = len;
   }
   // Where the carriers go before their final skill: the descent's top for a place.
   std::vector<JointVector> descend;
@@ -868,8 +1004,6 @@ bool Builder::Action(int i) {
       return false;
   }
   {
-    // Open each grasper to its grasp before it moves in.
-    for (int r : graspers) opening_[r] = GraspOpening(w_.robots[r], new_grasp);
     // One robot after another (prioritised): the carriers bring their objects, then the
     // graspers come to them. Each search is in one arm's space; the schedule lets the moves
     // overlap in time where their sweeps allow. When that fails, all of them at once in their
@@ -877,27 +1011,64 @@ bool Builder::Action(int i) {
     const size_t n_graspers = graspers.size();
     const size_t saved_out = out_.size();
     const std::vector<JointVector> saved_cur = cur_;
+    const std::vector<double> saved_opening = opening_;
     const int saved_index = free_index_;
-    bool ok = true;
-    for (size_t pass = 0; pass < 2 && ok; ++pass) {
-      for (size_t k = 0; k < free_robots.size() && ok; ++k) {
-        const bool is_grasper = k < n_graspers;
-        if (is_grasper != (pass == 1)) continue;
-        std::vector<int> objects;
-        if (is_grasper && grasped >= 0) objects.push_back(grasped);
-        if (!is_grasper) {
-          for (const Moving& m : moving) {
-            if (m.holders.size() == 1 && m.holders[0] == free_robots[k]) objects.push_back(m.node);
+    // Carriers first; when that fails, the graspers first (a carrier's goal may be where a
+    // grasper stands now).
+    const int n_orders = n_graspers > 0 && free_robots.size() > n_graspers ? 2 : 1;
+    bool ok = false;
+    for (int order = 0; order < n_orders && !ok; ++order) {
+      if (order > 0) {
+        if (cancelled_ || ctx_.cancelled()) return false;
+        out_.resize(saved_out);
+        cur_ = saved_cur;
+        opening_ = saved_opening;
+        free_index_ = saved_index + static_cast<int>(free_robots.size());
+      }
+      ok = true;
+      for (size_t pass = 0; pass < 2 && ok; ++pass) {
+        for (size_t k = 0; k < free_robots.size() && ok; ++k) {
+          const bool is_grasper = k < n_graspers;
+          if (is_grasper != ((pass == 1) != (order == 1))) continue;
+          std::vector<int> objects;
+          if (is_grasper && grasped >= 0) objects.push_back(grasped);
+          if (!is_grasper) {
+            for (const Moving& m : moving) {
+              if (m.holders.size() == 1 && m.holders[0] == free_robots[k])
+                objects.push_back(m.node);
+            }
+          }
+          std::vector<JointVector> others;
+          if (is_grasper) {
+            for (const Alternative& alt : alternatives[k]) others.push_back(alt.approach.front());
+          }
+          // A grasper opens to its grasp as it moves in (not before: robots moving earlier
+          // pass its fingers as they are).
+          if (is_grasper) {
+            opening_[free_robots[k]] = GraspOpening(w_.robots[free_robots[k]], new_grasp);
+          }
+          int reached = 0;
+          ok = Free(i, true, {free_robots[k]}, {free_goals[k]}, objects, &others, &reached);
+          if (ok && reached > 0) {
+            // It reached another IK solution of the grasp: the keyframe follows.
+            Alternative& alt = alternatives[k][reached - 1];
+            const int r = free_robots[k];
+            Rebranch(r, i, false, K.q[r], alt.q);
+            std::swap(approaches[k], alt.approach);
+            std::swap(approach_len[k], alt.length);
+            alt.q = K.q[r];
+            free_goals[k] = approaches[k].front();
           }
         }
-        ok = Free(i, true, {free_robots[k]}, {free_goals[k]}, objects);
       }
     }
     if (!ok && free_robots.size() > 1) {
       if (cancelled_ || ctx_.cancelled()) return false;
       out_.resize(saved_out);
       cur_ = saved_cur;
-      free_index_ = saved_index + static_cast<int>(free_robots.size());
+      opening_ = saved_opening;
+      for (int r : graspers) opening_[r] = GraspOpening(w_.robots[r], new_grasp);
+      free_index_ = saved_index + n_orders * static_cast<int>(free_robots.size());
       std::vector<size_t> order(free_robots.size());
       for (size_t k = 0; k < order.size(); ++k) order[k] = k;
       std::sort(order.begin(), order.end(),

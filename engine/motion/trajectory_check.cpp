@@ -302,7 +302,12 @@ void Checker::CheckDense() {
   for (const MotionSegment& m : plan_.segments) {
     if (m.kind == "insert" && m.objects.size() >= 2 && m.action >= 0) {
       windows.push_back({m.start_s, plan_.actions[m.action].end_s, -1, m.objects[0], m.objects[1]});
-    } else if ((m.kind == "approach" || m.kind == "retreat") && !m.robots.empty()) {
+    } else if (m.kind == "approach" && !m.robots.empty() && m.action >= 0) {
+      // The gripper touches its object (a suction cup does) from the end of the approach
+      // through the grip to the grasp event.
+      const double t1 = std::max(m.end_s, plan_.actions[m.action].end_s);
+      for (int o : m.objects) windows.push_back({m.start_s, t1, m.robots[0], o, -1});
+    } else if (m.kind == "retreat" && !m.robots.empty()) {
       for (int o : m.objects) windows.push_back({m.start_s, m.end_s, m.robots[0], o, -1});
     }
   }

@@ -51,6 +51,21 @@ TEST(PlanCli, PlansValidatesAndWritesThePlan) {
   ASSERT_FALSE(plan["actions"].empty());
   EXPECT_TRUE(plan["actions"][0].contains("keyframe"));
   EXPECT_TRUE(plan["actions"][0]["keyframe"]["q"].contains("left"));
+
+  // `wrap validate --plan` also checks the trajectories of a plan with motion, and catches a
+  // knot moved off its path.
+  const CliRun again = Wrap({"validate", Project("half_stool"), "--plan", out.string()});
+  EXPECT_EQ(again.code, 0) << again.out << again.err;
+  EXPECT_NE(again.out.find("Trajectories checked:"), std::string::npos) << again.out;
+  nlohmann::ordered_json moved = nlohmann::ordered_json::parse(std::ifstream(out));
+  nlohmann::ordered_json& q = moved["trajectories"][0]["q"];
+  ASSERT_GT(q.size(), 2u);
+  q[q.size() / 2][0] = q[q.size() / 2][0].get<double>() + 0.5;
+  const fs::path bad = dir / "moved_knot.json";
+  std::ofstream(bad) << moved.dump(2);
+  const CliRun caught = Wrap({"validate", Project("half_stool"), "--plan", bad.string()});
+  EXPECT_EQ(caught.code, 1) << caught.out << caught.err;
+  EXPECT_NE(caught.err.find("Trajectory check FAILED"), std::string::npos) << caught.err;
 }
 
 TEST(PlanCli, SeedAndWrenchModeReachTheStats) {

@@ -12,64 +12,34 @@
 #include <string>
 #include <vector>
 
-#include "../task/planning_fixture.h"
 #include "motion/keyframe_opt.h"
+#include "motion_fixture.h"
 #include "robot/ik.h"
 #include "robot/kinematics.h"
 
 namespace wrap {
 namespace {
 
-// A project planned once (seed 1) with its world, shared by the tests of this binary.
-struct Planned {
-  fs::path file;
-  LoadedProject lp;
-  std::optional<Preprocessed> pre;
-  std::optional<TaskWorld> world;
+// A project task-planned once (seed 1), shared by the tests of this binary.
+struct Planned : PreparedProject {
   Plan plan;
-  std::string error;  // empty when planned
+  void Solve(const std::string& name) {
+    RunContext ctx(1);
+    ctx.set_time_limit_s(120.0);
+    TaskPlannerOptions options;
+    options.project_file = file;
+    auto planned = PlanTask(*lp.project, lp.check, *pre, options, ctx);
+    if (!planned) {
+      error = planned.error().message;
+    } else if (!planned->stats.solved) {
+      error = name + ": not solved: " + planned->stats.failure;
+    } else {
+      plan = std::move(*planned);
+    }
+  }
 };
 
-const Planned& PlanOnce(const std::string& name) {
-  static std::map<std::string, std::unique_ptr<Planned>> cache;
-  auto& slot = cache[name];
-  if (slot) return *slot;
-  slot = std::make_unique<Planned>();
-  Planned& p = *slot;
-  p.file = ProjectFile(name);
-  p.lp = LoadProject(p.file);
-  if (!p.lp.ok()) {
-    p.error = name + ": does not load";
-    return p;
-  }
-  RunContext ctx(1);
-  ctx.set_time_limit_s(120.0);
-  PreprocessOptions pre_options;
-  pre_options.project_file = p.file;
-  auto pre = Preprocess(*p.lp.project, p.lp.check, pre_options, ctx);
-  if (!pre) {
-    p.error = pre.error().message;
-    return p;
-  }
-  p.pre = std::move(*pre);
-  auto world = BuildTaskWorld(*p.lp.project, p.lp.check, *p.pre, p.file);
-  if (!world) {
-    p.error = world.error().message;
-    return p;
-  }
-  p.world = std::move(*world);
-  TaskPlannerOptions options;
-  options.project_file = p.file;
-  auto plan = PlanTask(*p.lp.project, p.lp.check, *p.pre, options, ctx);
-  if (!plan) {
-    p.error = plan.error().message;
-  } else if (!plan->stats.solved) {
-    p.error = name + ": not solved: " + plan->stats.failure;
-  } else {
-    p.plan = std::move(*plan);
-  }
-  return p;
-}
+const Planned& PlanOnce(const std::string& name) { return PrepareOnce<Planned>(name); }
 
 PlanValidation Validate(const Planned& p, const Plan& plan) {
   auto v = ValidatePlan(*p.lp.project, p.lp.check, plan, PlanValidationOptions{}, p.file);

@@ -15,10 +15,10 @@
 #include <thread>
 #include <vector>
 
-#include "../task/planning_fixture.h"
 #include "motion/ompl_adapter.h"
 #include "motion/retime.h"
 #include "motion/trajectory_check.h"
+#include "motion_fixture.h"
 #include "pipeline/pipeline.h"
 #include "robot/kinematics.h"
 #include "task/plan_json.h"
@@ -90,6 +90,35 @@ TEST(OmplAdapter, StraightLineWhenFreeAndNamesABlockedGoal) {
   EXPECT_NE(a.why.find("goal"), std::string::npos) << a.why;
 }
 
+TEST(OmplAdapter, OtherGoalsServeWhenTheGoalIsBlockedOrWalledIn) {
+  PathQuery q = WallQuery();
+  // The goal in collision, another goal beyond the wall: reached through the gap.
+  q.goal = Eigen::Vector2d(0.5, 0.5);
+  q.other_goals = {Eigen::Vector2d(0.5, 0.5), Eigen::Vector2d(0.9, 0.3)};
+  PathAnswer a = PlanPath(q);
+  ASSERT_TRUE(a.solved) << a.why;
+  EXPECT_EQ(a.goal_index, 2);
+  EXPECT_TRUE(a.path.back().isApprox(q.other_goals[1]));
+  EXPECT_GE(a.path.size(), 3u);
+  // The goal free but walled in (no way out of the box around it), another goal straight ahead.
+  q.goal = Eigen::Vector2d(0.9, 0.9);
+  q.valid = [](const Eigen::VectorXd& x) {
+    const bool box = x[0] >= 0.8 && x[1] >= 0.8 && (x[0] <= 0.82 || x[1] <= 0.82);
+    return !box;
+  };
+  q.other_goals = {Eigen::Vector2d(0.3, 0.1)};
+  a = PlanPath(q);
+  ASSERT_TRUE(a.solved) << a.why;
+  EXPECT_EQ(a.goal_index, 1);
+  EXPECT_EQ(a.path.size(), 2u);  // the straight line to it
+  // Every goal walled in or blocked: no path, the search times out.
+  q.other_goals = {Eigen::Vector2d(0.81, 0.9)};
+  q.time_limit_s = 0.2;
+  a = PlanPath(q);
+  EXPECT_FALSE(a.solved);
+  EXPECT_TRUE(a.timed_out);
+}
+
 TEST(OmplAdapter, NoPathTimesOutAndStopsOnRequest) {
   PathQuery q = WallQuery();
   q.valid = [](const Eigen::VectorXd& x) { return x[0] < 0.45 || x[0] > 0.55; };  // no gap
@@ -109,21 +138,15 @@ TEST(OmplAdapter, NoPathTimesOutAndStopsOnRequest) {
 // ---------------------------------------------------------------------------------------------
 // Example projects end to end
 
-struct Planned {
-  fs::path file;
-  LoadedProject lp;
-  std::optional<Preprocessed> pre;
-  std::optional<TaskWorld> world;
-  std::optional<Plan> plan;
-  std::string error;
-};
-
-Plan RunPipeline(const Planned& p, std::uint64_t seed, std::string* error) {
+// Plans with motion; segment_time_s > 0 replaces the path searches' budget at effort 0.
+Plan RunPipeline(const PreparedProject& p, std::uint64_t seed, std::string* error,
+                 double segment_time_s = 0.0) {
   RunContext ctx(seed);
   ctx.set_time_limit_s(120.0);
   PipelineOptions options;
   options.task.project_file = p.file;
   options.seed = seed;
+  if (segment_time_s > 0.0) options.motion.segment_time_s = segment_time_s;
   auto plan = PlanAssembly(*p.lp.project, p.lp.check, *p.pre, options, ctx);
   if (!plan) {
     *error = plan.error().message;
@@ -132,33 +155,13 @@ Plan RunPipeline(const Planned& p, std::uint64_t seed, std::string* error) {
   return *plan;
 }
 
-const Planned& PlanOnce(const std::string& name) {
-  static std::map<std::string, std::unique_ptr<Planned>> cache;
-  auto& slot = cache[name];
-  if (slot) return *slot;
-  slot = std::make_unique<Planned>();
-  Planned& p = *slot;
-  p.file = ProjectFile(name);
-  p.lp = LoadProject(p.file);
-  if (!p.lp.ok()) {
-    p.error = "does not load";
-    return p;
-  }
-  auto pre = PreprocessProject(p.lp, p.file);
-  if (!pre) {
-    p.error = pre.error().message;
-    return p;
-  }
-  p.pre = std::move(*pre);
-  auto world = BuildTaskWorld(*p.lp.project, p.lp.check, *p.pre, p.file);
-  if (!world) {
-    p.error = world.error().message;
-    return p;
-  }
-  p.world = std::move(*world);
-  p.plan = RunPipeline(p, 1, &p.error);
-  return p;
-}
+// A project planned with motion once (seed 1), shared by the tests of this binary.
+struct Planned : PreparedProject {
+  std::optional<Plan> plan;
+  void Solve(const std::string&) { plan = RunPipeline(*this, 1, &error); }
+};
+
+const Planned& PlanOnce(const std::string& name) { return PrepareOnce<Planned>(name); }
 
 class ExampleMotion : public ::testing::TestWithParam<std::string> {};
 
@@ -225,26 +228,29 @@ INSTANTIATE_TEST_SUITE_P(Examples, ExampleMotion,
                                            "fabrica_car"));
 
 // Deterministic as long as no path search runs out of time (a time budget depends on the
-// machine's load): half_stool's searches take milliseconds.
+// machine's load): half_stool's searches take milliseconds, and here each may take 30 s.
 TEST(Motion, SameSeedSameTrajectories) {
   const Planned& p = PlanOnce("half_stool");
   ASSERT_TRUE(p.error.empty()) << p.error;
-  ASSERT_TRUE(p.plan->stats.solved) << p.plan->stats.failure;
-  EXPECT_EQ(p.plan->stats.motion_suspensions, 0);
   std::string error;
-  const Plan again = RunPipeline(p, 1, &error);
+  const Plan first = RunPipeline(p, 1, &error, 30.0);
   ASSERT_TRUE(error.empty()) << error;
-  ASSERT_EQ(again.trajectories.size(), p.plan->trajectories.size());
+  ASSERT_TRUE(first.stats.solved) << first.stats.failure;
+  EXPECT_EQ(first.stats.motion_suspensions, 0);
+  const Plan again = RunPipeline(p, 1, &error, 30.0);
+  ASSERT_TRUE(error.empty()) << error;
+  ASSERT_EQ(again.trajectories.size(), first.trajectories.size());
+  EXPECT_FALSE(again.trajectories.empty());
   for (size_t r = 0; r < again.trajectories.size(); ++r) {
     const auto& a = again.trajectories[r].knots;
-    const auto& b = p.plan->trajectories[r].knots;
+    const auto& b = first.trajectories[r].knots;
     ASSERT_EQ(a.size(), b.size()) << r;
     for (size_t k = 0; k < a.size(); ++k) {
       EXPECT_EQ(a[k].t, b[k].t);
       EXPECT_EQ(a[k].q, b[k].q);
     }
   }
-  EXPECT_EQ(again.stats.makespan_s, p.plan->stats.makespan_s);
+  EXPECT_EQ(again.stats.makespan_s, first.stats.makespan_s);
 }
 
 TEST(Motion, PlanJsonKeepsTheTrajectories) {
