@@ -9,10 +9,14 @@
 
 #include "gui/document.h"
 #include "gui/planner_job.h"
-#include "gui/viewport_renderer.h"
+#include "render/window_renderer.h"
 #include "task/plan.h"
 
 namespace wrap::gui {
+
+using render::SceneArrow;
+using render::SceneMarker;
+using render::ViewportRenderer;
 
 /// What is selected, shared by the viewport, the DAG canvas and the editors.
 struct Selection {

@@ -16,7 +16,7 @@
 #include "sim/mjcf.h"
 #include "sim/scene.h"
 
-namespace wrap::gui {
+namespace wrap::render {
 
 /// An arrow drawn into the scene (e.g. the insertion axis of the selected step).
 struct SceneArrow {
@@ -82,4 +82,4 @@ class ViewportRenderer {
   std::vector<SceneMarker> markers_;
 };
 
-}  // namespace wrap::gui
+}  // namespace wrap::render

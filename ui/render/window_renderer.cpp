@@ -1,4 +1,4 @@
-#include "gui/viewport_renderer.h"
+#include "render/window_renderer.h"
 
 #include <mujoco/mujoco.h>
 
@@ -8,7 +8,7 @@
 #include "sim/mjcf.h"
 #include "sim/mujoco_model.h"
 
-namespace wrap::gui {
+namespace wrap::render {
 
 namespace {
 constexpr int kExtraGeoms = 64;  // arrows and markers added after mjv_updateScene
@@ -200,4 +200,4 @@ int ViewportRenderer::Pick(double rel_x, double rel_y) const {
   return it == s.part_body.end() ? -1 : static_cast<int>(it - s.part_body.begin());
 }
 
-}  // namespace wrap::gui
+}  // namespace wrap::render
