@@ -1,8 +1,10 @@
 #include "motion/motion.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "motion/retime.h"
+#include "motion/trajectory_check.h"
 
 namespace wrap {
 
@@ -39,6 +41,32 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
   plan.stats.makespan_s = timing->makespan_s;
   plan.stats.makespan_sequential_s = timing->makespan_sequential_s;
   plan.stats.motion_segments = static_cast<int>(segments->size());
+  if (options.self_check) {
+    t0 = std::chrono::steady_clock::now();
+    auto check = CheckTrajectories(world, plan, TrajectoryCheckOptions{});
+    out.t_mp_s += Since(t0);
+    if (!check) return std::unexpected(check.error());
+    if (!check->valid) {
+      // The action under way at the first issue's moment.
+      const TrajectoryIssue& issue = check->issues.front();
+      int action = static_cast<int>(plan.actions.size()) - 1;
+      for (size_t i = 0; i < plan.actions.size(); ++i) {
+        if (plan.actions[i].end_s >= issue.t) {
+          action = static_cast<int>(i);
+          break;
+        }
+      }
+      out.failure.action = std::max(action, 0);
+      out.failure.segment = "timed";
+      out.failure.suspend = false;
+      out.failure.message = "the trajectory check found " + std::to_string(check->issues.size()) +
+                            " issue(s), the first: " + FormatTrajectoryIssue(plan, issue);
+      plan.trajectories.clear();
+      plan.segments.clear();
+      plan.stats.motion = false;
+      return out;
+    }
+  }
   out.solved = true;
   return out;
 }

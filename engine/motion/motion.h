@@ -25,6 +25,8 @@ struct MotionAttempt {
 /// options.segment_time_s * 2^effort; `cache` keeps the paths solved by earlier attempts on the
 /// same plan). On success fills plan.trajectories, plan.segments, every action's start_s and
 /// end_s, and the stats' makespan_s, makespan_sequential_s, motion_segments and motion = true.
+/// With options.self_check, timed trajectories that fail the independent check are not kept:
+/// the attempt fails (segment "timed", not to be retried) naming the first issue.
 /// Fails with kCancelled when ctx is cancelled, kInvalidInput when the plan does not fit the world.
 Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const MotionOptions& options,
                                  int effort, std::uint64_t seed, MotionCache& cache,

@@ -41,6 +41,9 @@ struct MotionOptions {
   double grip_s = 0.4;              ///< A gripper closing or opening at a keyframe [s].
   /// Shortcut attempts per free path.
   int shortcut_attempts = 60;
+  /// Run the independent trajectory check on the timed result; a plan that fails it has no
+  /// motion (its first issue is the failure), so no colliding trajectory leaves the planner.
+  bool self_check = true;
 };
 
 /// A segment of the geometric motion.

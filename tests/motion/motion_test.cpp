@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "motion/motion.h"
 #include "motion/ompl_adapter.h"
 #include "motion/retime.h"
 #include "motion/trajectory_check.h"
@@ -251,6 +252,37 @@ TEST(Motion, SameSeedSameTrajectories) {
     }
   }
   EXPECT_EQ(again.stats.makespan_s, first.stats.makespan_s);
+}
+
+// Paths searched at a resolution far too coarse step through obstacles; the independent check
+// inside PlanMotion refuses them, so no colliding trajectory leaves the planner.
+TEST(Motion, TheSelfCheckRefusesTrajectoriesThatCollide) {
+  const Planned& p = PlanOnce("half_stool");
+  ASSERT_TRUE(p.error.empty()) << p.error;
+  MotionOptions coarse;
+  coarse.resolution_rad = 1.5;
+  coarse.self_check = false;
+  Plan unchecked = *p.plan;
+  MotionCache cache;
+  RunContext ctx(1);
+  auto attempt = PlanMotion(*p.world, unchecked, coarse, 0, 3, cache, ctx);
+  ASSERT_TRUE(attempt.has_value()) << attempt.error().message;
+  ASSERT_TRUE(attempt->solved) << attempt->failure.message;
+  auto check = CheckTrajectories(*p.world, unchecked, TrajectoryCheckOptions{});
+  ASSERT_TRUE(check.has_value());
+  ASSERT_FALSE(check->valid);  // the premise: the coarse search let a collision through
+  coarse.self_check = true;
+  Plan checked = *p.plan;
+  MotionCache cache2;
+  attempt = PlanMotion(*p.world, checked, coarse, 0, 3, cache2, ctx);
+  ASSERT_TRUE(attempt.has_value()) << attempt.error().message;
+  EXPECT_FALSE(attempt->solved);
+  EXPECT_EQ(attempt->failure.segment, "timed");
+  EXPECT_FALSE(attempt->failure.suspend);
+  EXPECT_NE(attempt->failure.message.find("trajectory check"), std::string::npos)
+      << attempt->failure.message;
+  EXPECT_FALSE(checked.stats.motion);
+  EXPECT_TRUE(checked.trajectories.empty());
 }
 
 TEST(Motion, PlanJsonKeepsTheTrajectories) {
