@@ -69,7 +69,7 @@ int Sim(const SimArgs& args, std::ostream& out, std::ostream& err) {
       << "peak utilisation: transport 2F " << Percent(u.two_finger_transport) << ", vacuum "
       << Percent(u.vacuum_transport) << "; insertion 2F " << Percent(u.two_finger_insertion)
       << ", vacuum " << Percent(u.vacuum_insertion) << "; connections " << Percent(u.connection)
-      << "\n";
+      << "; table friction " << Percent(u.table_friction) << "\n";
   if (report->failure) {
     const SimFailure& f = *report->failure;
     out << "failure: action " << f.action;

@@ -37,7 +37,8 @@ std::string SerializeSimReport(const SimReport& report) {
                                    {"insertion",
                                     {{"two_finger", Percent(report.peak.two_finger_insertion)},
                                      {"vacuum", Percent(report.peak.vacuum_insertion)}}},
-                                   {"connection", Percent(report.peak.connection)}};
+                                   {"connection", Percent(report.peak.connection)},
+                                   {"table_friction", Percent(report.peak.table_friction)}};
   Json actions = Json::array();
   for (size_t i = 0; i < report.actions.size(); ++i) {
     const SimActionStatus& a = report.actions[i];

@@ -455,6 +455,29 @@ class Simulator {
     tau_G = X_WG.linear().transpose() * tau_W;
   }
 
+  // Friction use of every part-table (or floor) contact.
+  void MeasureTable() {
+    const mjModel* m = model_.get();
+    const mjData* d = data_.get();
+    constexpr double kMinNormal_N = 0.05;
+    // Only parts that rest: a held part dragged over the table is the gripper's business.
+    std::vector<char> held_body(m->nbody, 0);
+    for (const auto& [node, o] : objects_) {
+      if (o.holders.empty()) continue;
+      for (int p : tree_.nodes[node].parts) held_body[part_body_[p]] = 1;
+    }
+    for (int i = 0; i < d->ncon; ++i) {
+      const mjContact& c = d->contact[i];
+      if (held_body[m->geom_bodyid[c.geom1]] || held_body[m->geom_bodyid[c.geom2]]) continue;
+      if (c.exclude != 0 || c.efc_address < 0 || c.friction[0] <= 0.0) continue;
+      mjtNum f[6];
+      mj_contactForce(m, d, i, f);
+      if (f[0] < kMinNormal_N) continue;
+      const double use = std::hypot(f[1], f[2]) / (c.friction[0] * f[0]);
+      report_.peak.table_friction = std::max(report_.peak.table_friction, use);
+    }
+  }
+
   // Every made connection against its limits, in its connection frame.
   void MeasureConnections() {
     for (const Join& j : joins_) {
@@ -530,6 +553,7 @@ class Simulator {
       }
     }
     MeasureConnections();
+    MeasureTable();
     // Every part where the plan has it.
     for (const auto& [node, o] : objects_) {
       const Iso3 X_WA = ExpectedX_WA(o);
