@@ -390,10 +390,8 @@ bool Builder::Tight(int robot, const JointVector& q) {
 std::vector<JointVector> Builder::BackOff(int robot, const JointVector& q, double* length) {
   const Iso3 X0 = Tcp(robot, q);
   const Vec3 axis = X0.linear().col(2);
-  // Longer first where the end of the usual length is in a tight pocket (free path searches
-  // hardly leave one); then the usual length and shorter ones.
-  std::vector<std::vector<JointVector>> longer;
-  for (double d : {opt_.approach_m, 2 * opt_.approach_m, 3 * opt_.approach_m}) {
+  // The straight move back by d, collision-free, or empty (last_hit_ says why).
+  auto straight = [&](double d) {
     const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
     auto target = [X0, axis, d](double s) {
       Iso3 X = X0;
@@ -401,9 +399,20 @@ std::vector<JointVector> Builder::BackOff(int robot, const JointVector& q, doubl
       return X;
     };
     auto path = Track({robot}, {q}, {target}, steps);
-    if (path.empty() || !PathClear({robot}, path)) break;
     std::vector<JointVector> out;
-    for (auto& wp : path) out.push_back(wp[0]);
+    if (path.empty()) {
+      last_hit_ = "no IK solution along the line";
+    } else if (PathClear({robot}, path)) {
+      for (auto& wp : path) out.push_back(wp[0]);
+    }
+    return out;
+  };
+  // Longer first where the end of the usual length is in a tight pocket (free path searches
+  // hardly leave one); then the usual length and shorter ones.
+  std::vector<std::vector<JointVector>> longer;
+  for (double d : {opt_.approach_m, 2 * opt_.approach_m, 3 * opt_.approach_m}) {
+    std::vector<JointVector> out = straight(d);
+    if (out.empty()) break;
     *length = d;
     if (!Tight(robot, out.back()) || d > 2.5 * opt_.approach_m) return out;
     longer.push_back(std::move(out));
@@ -413,20 +422,8 @@ std::vector<JointVector> Builder::BackOff(int robot, const JointVector& q, doubl
     return longer.back();
   }
   for (double d : {opt_.approach_m / 2, opt_.approach_m / 4, opt_.approach_m / 8}) {
-    const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
-    auto target = [X0, axis, d](double s) {
-      Iso3 X = X0;
-      X.translation() -= s * d * axis;
-      return X;
-    };
-    auto path = Track({robot}, {q}, {target}, steps);
-    if (path.empty()) {
-      last_hit_ = "no IK solution along the line";
-      continue;
-    }
-    if (!PathClear({robot}, path)) continue;
-    std::vector<JointVector> out;
-    for (auto& wp : path) out.push_back(wp[0]);
+    std::vector<JointVector> out = straight(d);
+    if (out.empty()) continue;
     *length = d;
     return out;
   }
