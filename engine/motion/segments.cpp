@@ -1050,10 +1050,12 @@ bool Builder::Action(int i) {
             // It reached another IK solution of the grasp: the keyframe follows.
             Alternative& alt = alternatives[k][reached - 1];
             const int r = free_robots[k];
-            Rebranch(r, i, false, K.q[r], alt.q);
+            // The old solution stays an alternative (Rebranch overwrites K.q[r]).
+            const JointVector old_q = K.q[r];
+            Rebranch(r, i, false, old_q, alt.q);
             std::swap(approaches[k], alt.approach);
             std::swap(approach_len[k], alt.length);
-            alt.q = K.q[r];
+            alt.q = old_q;
             free_goals[k] = approaches[k].front();
           }
         }
