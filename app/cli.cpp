@@ -125,6 +125,43 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   sim->add_option("--mjcf", sim_args.mjcf_dir,
                   "Also write the physics model (cell.xml + meshes) to this folder");
 
+  BenchArgs bench_args;
+  double bench_time_limit = 0.0;
+  CLI::App* bench = app.add_subcommand(
+      "bench",
+      "Benchmark suites (paper V): planner runs in child processes with time and memory limits, "
+      "results.csv and a report with the paper's tables and figures");
+  bench->add_option("--suite", bench_args.suite,
+                    "paper (comparison, breakdown, convergence on cross, stool, chair), fabrica, "
+                    "scaling (robots, wrench models, parts), ablation (wrench models simulated), "
+                    "all, or tiny (the test suite's)");
+  bench->add_option("--runs", bench_args.runs, "Seeds per configuration (default 3)")
+      ->check(CLI::PositiveNumber);
+  CLI::Option* bench_time_option = bench->add_option(
+      "--time-limit", bench_time_limit, "Planner time limit [s] (default: the suite's)")
+      ->check(CLI::PositiveNumber);
+  bench->add_option("--jobs", bench_args.jobs, "Runs at once (default: the number of cores)")
+      ->check(CLI::PositiveNumber);
+  bench->add_option("--shard", bench_args.shard,
+                    "Run the I-th of N slices of the suite, e.g. 3/8 (combine with 'merge')");
+  bench->add_option("-o,--output", bench_args.output, "Output folder (created; a rerun resumes)");
+  bench->add_option("--projects", bench_args.projects,
+                    "Folder of the example projects (default: projects)");
+  bench->add_option("--hard-limit", bench_args.hard_limit_s,
+                    "Wall-clock limit of each child [s] after which it is killed and recorded as "
+                    "a timeout (default: time limit + max(10 s, half of it))")
+      ->check(CLI::PositiveNumber);
+  bench->add_option("--memory-limit", bench_args.memory_limit_mib,
+                    "Planner memory limit [MiB] (default 4096); the child's address space is "
+                    "limited to 4x this")
+      ->check(CLI::PositiveNumber);
+  bench->add_flag("--keep-plans", bench_args.keep_plans, "Keep every plan JSON under plans/");
+  CLI::App* bench_merge = bench->add_subcommand(
+      "merge", "Combine the results of shard folders into one results.csv and report");
+  bench_merge->add_option("DIR", bench_args.merge_dirs, "Shard output folders")->required();
+  std::string merge_output;
+  bench_merge->add_option("-o,--output", merge_output, "Output folder")->required();
+
   // No subcommand: the GUI, optionally on a project, with its headless hooks.
   GuiArgs gui;
   double gui_at = 0.0;
@@ -156,6 +193,11 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   }
   if (render->parsed()) return Render(ren, out, err);
   if (sim->parsed()) return Sim(sim_args, out, err);
+  if (bench->parsed()) {
+    if (bench_time_option->count() > 0) bench_args.time_limit_s = bench_time_limit;
+    if (bench_merge->parsed()) bench_args.output = merge_output;
+    return Bench(bench_args, out, err);
+  }
   if (plan->parsed()) {
     if (plan_seed_option->count() > 0) plan_args.seed = plan_seed;
     if (plan_time_option->count() > 0) plan_args.time_limit = plan_time_limit;

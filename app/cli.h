@@ -112,6 +112,27 @@ struct SimArgs {
 /// 1 fails, 2 bad input, 3 internal (a MuJoCo error).
 int Sim(const SimArgs& args, std::ostream& out, std::ostream& err);
 
+/// Arguments of `wrap bench` and `wrap bench merge`.
+struct BenchArgs {
+  std::string suite = "paper";           ///< --suite paper|fabrica|scaling|ablation|all|tiny.
+  int runs = 3;                          ///< --runs: seeds per configuration.
+  std::optional<double> time_limit_s;    ///< --time-limit [s]; absent: the suite's default.
+  int jobs = 0;                          ///< --jobs; 0: the number of cores.
+  std::string shard;                     ///< --shard I/N; empty: the whole suite.
+  std::string output;                    ///< -o DIR (created).
+  std::string projects = "projects";     ///< --projects DIR of the example projects.
+  double hard_limit_s = 0.0;             ///< --hard-limit [s] per child; 0: automatic.
+  long long memory_limit_mib = 4096;     ///< --memory-limit [MiB] of each planner run.
+  bool keep_plans = false;               ///< --keep-plans.
+  std::vector<std::string> merge_dirs;   ///< `bench merge DIR...`; empty: run a suite.
+};
+
+/// `wrap bench --suite S -o DIR`: runs the suite's planner runs in child processes (time and
+/// memory limits; timeouts, out-of-memory and crashes recorded), writes runs/, results.csv,
+/// report.md and report.html; `wrap bench merge DIR... -o OUT` combines shards. Exit 0, 1
+/// interrupted (resume by running again), 2 bad input, 3 internal.
+int Bench(const BenchArgs& args, std::ostream& out, std::ostream& err);
+
 /// Arguments of the GUI (`wrap` without a subcommand).
 struct GuiArgs {
   std::string project;       ///< PROJECT to open; empty: a new project.
