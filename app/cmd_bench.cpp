@@ -36,8 +36,8 @@ void PrintProgress(const bench::Progress& p, std::ostream& err, bool tty) {
   std::string counts;
   for (const auto& [k, n] : p.counts) counts += " " + k + " " + std::to_string(n);
   const std::string status = "[" + std::string(filled, '#') + std::string(width - filled, '.') +
-                             "] " + std::to_string(p.done) + "/" + std::to_string(p.total) +
-                             " " + counts + ", elapsed " + Duration(p.elapsed_s) + ", left ~" +
+                             "] " + std::to_string(p.done) + "/" + std::to_string(p.total) + " " +
+                             counts + ", elapsed " + Duration(p.elapsed_s) + ", left ~" +
                              Duration(p.eta_s);
   if (tty) {
     err << "\r\033[K" << p.last << "\n" << status << std::flush;
@@ -60,7 +60,8 @@ void Summarise(const std::vector<bench::RunResult>& results, const std::string& 
 
 int Bench(const BenchArgs& args, std::ostream& out, std::ostream& err) {
   if (!args.merge_dirs.empty()) {
-    if (args.output.empty()) return Report({ErrorCode::kInvalidInput, "merge: -o OUT is required"}, err);
+    if (args.output.empty())
+      return Report({ErrorCode::kInvalidInput, "merge: -o OUT is required"}, err);
     std::vector<std::filesystem::path> dirs(args.merge_dirs.begin(), args.merge_dirs.end());
     auto merged = bench::MergeShards(dirs, args.output);
     if (!merged) return Report(merged.error(), err);
@@ -96,7 +97,8 @@ int Bench(const BenchArgs& args, std::ostream& out, std::ostream& err) {
   auto specs = bench::MakeSuite(options);
   if (!specs) return Report(specs.error(), err);
   out << "Suite '" << options.suite << "': " << specs->size() << " runs";
-  if (options.shard_count > 1) out << " (this shard: " << options.shard_index << "/" << options.shard_count << ")";
+  if (options.shard_count > 1)
+    out << " (this shard: " << options.shard_index << "/" << options.shard_count << ")";
   out << "\n" << std::flush;
   auto results = bench::RunSuite(*specs, options, args.output);
   if (!results) return Report(results.error(), err);

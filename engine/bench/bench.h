@@ -17,26 +17,26 @@ namespace wrap::bench {
 /// A project of a suite: an example project, or a variant derived from one (fewer robots, or a
 /// prefix of its assembly sequence) that the harness writes into the output folder.
 struct ProjectSpec {
-  std::string name;  ///< Name in the results, e.g. "cross", "cross_r2", "cube_2x2x1".
-  std::string base;  ///< Example project it comes from (file `<projects>/<base>.json`).
-  int robots = 0;    ///< Keep the first N robots of the base; 0: all.
-  int steps = 0;     ///< Keep the first N steps of the base's sequence (and their parts); 0: all.
+  std::string name;   ///< Name in the results, e.g. "cross", "cross_r2", "cube_2x2x1".
+  std::string base;   ///< Example project it comes from (file `<projects>/<base>.json`).
+  int robots = 0;     ///< Keep the first N robots of the base; 0: all.
+  int steps = 0;      ///< Keep the first N steps of the base's sequence (and their parts); 0: all.
   std::string group;  ///< Which part of the report uses it: "comparison", "scaling", ...
 };
 
 /// One configuration of a suite: a project, a planner and its options, run once per seed.
 struct RunSpec {
-  ProjectSpec project;          ///< The project.
+  ProjectSpec project;           ///< The project.
   std::string planner = "wrap";  ///< `wrap plan --planner`.
-  std::string wrench = "full";  ///< `--wrench full|gravity|none`.
-  double force_scale = 1.0;     ///< `--force-scale` lambda.
-  bool optimize = false;        ///< `--optimize`.
-  bool motion = false;          ///< Plan motion too (no `--task-only`).
-  bool sim = false;             ///< Then run `wrap sim` on the plan (needs motion).
-  std::uint64_t seed = 0;       ///< `--seed`.
-  double time_limit_s = 30.0;   ///< `--time-limit` given to the planner [s].
-  std::string group;            ///< Report section: comparison, breakdown, scaling_robots,
-                                ///< scaling_parts, convergence, ablation, tiny.
+  std::string wrench = "full";   ///< `--wrench full|gravity|none`.
+  double force_scale = 1.0;      ///< `--force-scale` lambda.
+  bool optimize = false;         ///< `--optimize`.
+  bool motion = false;           ///< Plan motion too (no `--task-only`).
+  bool sim = false;              ///< Then run `wrap sim` on the plan (needs motion).
+  std::uint64_t seed = 0;        ///< `--seed`.
+  double time_limit_s = 30.0;    ///< `--time-limit` given to the planner [s].
+  std::string group;             ///< Report section: comparison, breakdown, scaling_robots,
+                                 ///< scaling_parts, convergence, ablation, tiny.
 
   /// The options as one CSV-safe string, e.g. "wrench=full;lambda=1;task-only".
   std::string Options() const;
@@ -53,12 +53,12 @@ std::optional<Status> ParseStatus(const std::string& word);
 
 /// What one run gave: the spec's columns, the classification and the plan's stats.
 struct RunResult {
-  RunSpec spec;                   ///< What was run.
+  RunSpec spec;                    ///< What was run.
   Status status = Status::kError;  ///< Classification (see RunSuite).
-  int exit_code = -1;             ///< Child exit code; -1 when it died of a signal.
-  int signal = 0;                 ///< Signal that ended the child, 0 if none.
-  double wall_s = 0.0;            ///< Wall time of the plan child [s].
-  double peak_rss_mib = 0.0;      ///< Peak resident memory of the plan child (wait4) [MiB].
+  int exit_code = -1;              ///< Child exit code; -1 when it died of a signal.
+  int signal = 0;                  ///< Signal that ended the child, 0 if none.
+  double wall_s = 0.0;             ///< Wall time of the plan child [s].
+  double peak_rss_mib = 0.0;       ///< Peak resident memory of the plan child (wait4) [MiB].
   /// The plan's stats by name (cost, first_cost, t_init_s, t_grasp_s, t_bwd_s, t_lp_s, t_fwd_s,
   /// t_ik_s, t_kf_s, t_mp_s, t_retime_s, t_opt_s, makespan_s); absent where the plan gave none.
   std::map<std::string, double> stats;
@@ -77,35 +77,34 @@ struct RunResult {
 
 /// Where a suite stands, for a progress bar.
 struct Progress {
-  int done = 0;            ///< Runs finished (this call's and reused ones).
-  int total = 0;           ///< Runs of this shard.
-  int running = 0;         ///< Children running now.
+  int done = 0;                       ///< Runs finished (this call's and reused ones).
+  int total = 0;                      ///< Runs of this shard.
+  int running = 0;                    ///< Children running now.
   std::map<std::string, int> counts;  ///< Finished runs by status word.
-  double elapsed_s = 0.0;  ///< Since the suite started [s].
-  double eta_s = -1.0;     ///< Estimated time left [s]; negative while unknown.
-  std::string last;        ///< The run that just finished, in words.
+  double elapsed_s = 0.0;             ///< Since the suite started [s].
+  double eta_s = -1.0;                ///< Estimated time left [s]; negative while unknown.
+  std::string last;                   ///< The run that just finished, in words.
 };
 
 /// Options of a suite run.
 struct BenchOptions {
-  std::string suite = "paper";      ///< paper, fabrica, scaling, ablation, all, tiny.
-  int runs = 3;                     ///< Seeds 0..runs-1 per configuration.
+  std::string suite = "paper";         ///< paper, fabrica, scaling, ablation, all, tiny.
+  int runs = 3;                        ///< Seeds 0..runs-1 per configuration.
   std::optional<double> time_limit_s;  ///< Planner time limit; absent: each suite's default.
-  int jobs = 0;                     ///< Runs at once; 0: the number of cores.
-  int shard_index = 1;              ///< This shard, 1..shard_count.
-  int shard_count = 1;              ///< Number of shards.
+  int jobs = 0;                        ///< Runs at once; 0: the number of cores.
+  int shard_index = 1;                 ///< This shard, 1..shard_count.
+  int shard_count = 1;                 ///< Number of shards.
   std::filesystem::path projects_dir = "projects";  ///< Where the example projects are.
-  std::filesystem::path wrap_exe;   ///< The `wrap` to run; empty: this executable.
+  std::filesystem::path wrap_exe;                   ///< The `wrap` to run; empty: this executable.
   /// Hard wall-clock limit of a child [s] after which it gets SIGTERM (SIGKILL 2 s later); 0:
   /// the planner's time limit plus max(10 s, half of it). A killed run is a timeout.
   double hard_limit_s = 0.0;
   long long memory_limit_mib = 4096;  ///< Planner memory limit (`--memory-limit`) [MiB]; the
                                       ///< child's address space is limited to 4x this.
-  bool keep_plans = false;          ///< Keep every plan JSON (plans/); default: deleted.
+  bool keep_plans = false;            ///< Keep every plan JSON (plans/); default: deleted.
   /// Called after each finished run (and for runs reused from an earlier, interrupted suite).
   std::function<void(const Progress&)> on_progress;
 };
-
 
 /// The configurations of a named suite in deterministic order (project, planner, options, seed).
 /// Fails with kInvalidInput for an unknown suite name.

@@ -11,9 +11,8 @@ namespace wrap::bench {
 namespace {
 
 const std::vector<std::string>& Columns() {
-  static const std::vector<std::string> c = {"cross",        "stool",
-                                             "chair",        "fabrica_beam",
-                                             "fabrica_plumbers_block", "fabrica_car"};
+  static const std::vector<std::string> c = {
+      "cross", "stool", "chair", "fabrica_beam", "fabrica_plumbers_block", "fabrica_car"};
   return c;
 }
 
@@ -33,8 +32,7 @@ std::optional<PaperComparison> PaperComparisonCell(const std::string& project,
       {"counting",
        {N(1.69, 22), N(41.12, 24), N(3.84, 31), N(10.26, 14), N(7.48, 14), N(19.53, 18)}},
       {"exact", {N(1.98, 22), N(12.51, 20), N(5.53, 31), N(9.96, 14), N(7.87, 14), N(19.37, 18)}},
-      {"fine",
-       {N(5.73, 22), N(2.02, 32), N(16.37, 43), N(10.34, 16), N(11.01, 14), N(22.10, 18)}},
+      {"fine", {N(5.73, 22), N(2.02, 32), N(16.37, 43), N(10.34, 16), N(11.01, 14), N(22.10, 18)}},
   };
   const auto row = table.find(planner);
   if (row == table.end()) return std::nullopt;
@@ -77,8 +75,8 @@ std::optional<PaperSim> PaperSimRow(const std::string& project, const std::strin
 
 std::string PaperProjectName(const std::string& project) {
   static const std::map<std::string, std::string> names = {
-      {"cross", "Cross"},         {"stool", "Stool"},
-      {"chair", "Chair"},         {"cube", "Cube"},
+      {"cross", "Cross"},          {"stool", "Stool"},
+      {"chair", "Chair"},          {"cube", "Cube"},
       {"fabrica_beam", "F. Beam"}, {"fabrica_plumbers_block", "F. Plumber block"},
       {"fabrica_car", "F. Car"}};
   const auto it = names.find(project);
@@ -87,9 +85,9 @@ std::string PaperProjectName(const std::string& project) {
 
 std::string PaperPlannerName(const std::string& planner) {
   static const std::map<std::string, std::string> names = {
-      {"optimistic", "Optimistic"},      {"wrap", "Ours (WRAP)"},
-      {"flat", "Flat lazy"},             {"counting", "Milestones + counting"},
-      {"exact", "Ours, exact fills"},    {"fine", "Ours, fine projection"}};
+      {"optimistic", "Optimistic"},   {"wrap", "Ours (WRAP)"},
+      {"flat", "Flat lazy"},          {"counting", "Milestones + counting"},
+      {"exact", "Ours, exact fills"}, {"fine", "Ours, fine projection"}};
   const auto it = names.find(planner);
   return it == names.end() ? planner : it->second;
 }

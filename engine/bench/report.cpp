@@ -123,13 +123,15 @@ class ReportBuilder {
 
   std::vector<Block> Build(const RunInfo& info) {
     Heading(1, "Wrap benchmark report");
-    Para("Machine: " + info.machine + ". " + info.load + ".");
+    Para("Machine: " + info.machine +
+         ". Load average (1, 5, 15 min; other work shares the machine): " + info.load + ".");
     Para("Commit: `" + info.commit + "`. Date: " + info.date + ". Settings: " + info.settings +
          ".");
-    Para("The paper's numbers (WRAP, Hartmann et al., §V) are means of 10 runs on the authors' "
-         "machine with their models of the assemblies; ours are from the runs below, on the "
-         "machine above. Times are wall-clock seconds of the planner's own clocks; `t_init` is "
-         "the time to the first task plan without preprocessing. Compare with care.");
+    Para(
+        "The paper's numbers (WRAP, Hartmann et al., §V) are means of 10 runs on the authors' "
+        "machine with their models of the assemblies; ours are from the runs below, on the "
+        "machine above. Times are wall-clock seconds of the planner's own clocks; `t_init` is "
+        "the time to the first task plan without preprocessing. Compare with care.");
     Summary();
     Comparison();
     Breakdown();
@@ -196,8 +198,9 @@ class ReportBuilder {
       rows.push_back({g, n("all"), n("solved"), n("unsolved"), n("timeout"), n("oom"), n("crash"),
                       n("error")});
     }
-    Para("Every run is one child process (`wrap plan`, then `wrap sim` where asked) under a "
-         "wall-clock and a memory limit; one row per run is in `results.csv`.");
+    Para(
+        "Every run is one child process (`wrap plan`, then `wrap sim` where asked) under a "
+        "wall-clock and a memory limit; one row per run is in `results.csv`.");
     Table({"group", "runs", "solved", "unsolved", "timeout", "oom", "crash", "error"}, rows);
   }
 
@@ -209,9 +212,10 @@ class ReportBuilder {
     for (const RunResult* r : runs) projects.insert(r->spec.project.name);
     if (projects.empty()) return;
     Heading(2, "Comparison (paper Table \"comparison\")");
-    Para("Time to first task plan `t_init` [s] and cost (number of actions) of the first plan: "
-         "mean ± std over the solved runs; the paper's mean beside ours and the ratio ours / "
-         "paper (below 1: we are faster or cheaper). Task plans only (`--task-only`).");
+    Para(
+        "Time to first task plan `t_init` [s] and cost (number of actions) of the first plan: "
+        "mean ± std over the solved runs; the paper's mean beside ours and the ratio ours / "
+        "paper (below 1: we are faster or cheaper). Task plans only (`--task-only`).");
     std::vector<std::vector<std::string>> rows;
     std::vector<std::string> order = kComparisonProjects;
     for (const std::string& p : projects) {
@@ -258,11 +262,12 @@ class ReportBuilder {
     }
     if (projects.empty()) return;
     Heading(2, "Where the time goes (paper Table \"search_time_spent\")");
-    Para("WRAP (`--planner wrap`), mean ± std [s] over the runs that reached a task plan, each "
-         "with the paper's mean after the slash. `t_grasp` preprocessing, `t_bwd` the backward "
-         "abstraction, `t_lp` the wrench LPs, `t_fwd` the forward search without IK and LPs, "
-         "`t_ik` IK and collision checks of keyframes, `t_mp` motion planning (runs with motion "
-         "only); `motion` counts the runs whose motion and retiming succeeded.");
+    Para(
+        "WRAP (`--planner wrap`), mean ± std [s] over the runs that reached a task plan, each "
+        "with the paper's mean after the slash. `t_grasp` preprocessing, `t_bwd` the backward "
+        "abstraction, `t_lp` the wrench LPs, `t_fwd` the forward search without IK and LPs, "
+        "`t_ik` IK and collision checks of keyframes, `t_mp` motion planning (runs with motion "
+        "only); `motion` counts the runs whose motion and retiming succeeded.");
     std::vector<std::vector<std::string>> rows;
     std::vector<std::string> order = kComparisonProjects;
     for (const std::string& p : projects) {
@@ -273,8 +278,7 @@ class ReportBuilder {
       auto runs = Select([&](const RunResult& r) {
         return r.spec.project.name == p && r.spec.planner == "wrap" && r.spec.motion &&
                !r.spec.optimize && !r.spec.sim && r.spec.wrench == "full" &&
-               r.spec.force_scale == 1.0 && r.spec.project.robots == 0 &&
-               r.spec.project.steps == 0;
+               r.spec.force_scale == 1.0 && r.spec.project.robots == 0 && r.spec.project.steps == 0;
       });
       const bool with_motion = !runs.empty();
       if (!with_motion) {
@@ -288,7 +292,9 @@ class ReportBuilder {
         // Task stages of runs that found a task plan, even where motion then failed.
         std::vector<const RunResult*> reached;
         for (const RunResult* r : runs) {
-          if (r->solved() || r->stats.contains("t_mp_s")) reached.push_back(r);
+          if (r->solved() || r->stats.contains("t_mp_s") || r->message.starts_with("no motion")) {
+            reached.push_back(r);
+          }
         }
         std::string s = MeanStd(Summarise(Values(reached, stat, false)));
         if (paper) s += " / " + Fmt("%.2f", paper_value);
@@ -303,11 +309,11 @@ class ReportBuilder {
         if (m.n > 0) motion += ", makespan " + Fmt("%.0f", m.mean) + " s";
       }
       const PaperBreakdown pb = paper.value_or(PaperBreakdown{});
-      rows.push_back({PaperProjectName(p), motion, cell("t_grasp_s", pb.t_grasp),
-                      cell("t_bwd_s", pb.t_bwd), cell("t_lp_s", pb.t_lp),
-                      cell("t_fwd_s", pb.t_fwd), cell("t_ik_s", pb.t_ik),
-                      with_motion ? cell("t_mp_s", pb.t_mp)
-                                  : std::string("–") + (paper ? " / " + Fmt("%.2f", pb.t_mp) : "")});
+      rows.push_back(
+          {PaperProjectName(p), motion, cell("t_grasp_s", pb.t_grasp), cell("t_bwd_s", pb.t_bwd),
+           cell("t_lp_s", pb.t_lp), cell("t_fwd_s", pb.t_fwd), cell("t_ik_s", pb.t_ik),
+           with_motion ? cell("t_mp_s", pb.t_mp)
+                       : std::string("–") + (paper ? " / " + Fmt("%.2f", pb.t_mp) : "")});
     }
     Table({"assembly", "motion", "t_grasp", "t_bwd", "t_lp", "t_fwd", "t_ik", "t_mp"}, rows);
   }
@@ -328,12 +334,13 @@ class ReportBuilder {
       return;
     }
     Heading(2, "Scaling with robots and wrench models (paper Figure \"scaling\")");
-    Para("Time to first task plan (mean of the solved runs, log scale) of the cross (two-finger "
-         "grippers) and the 2x2x3 cube (vacuum) with the first 2, 3 and 4 of their robots, "
-         "without wrench checks, with gravity only, and with the mating wrench scaled by λ. The "
-         "2- and 3-robot projects are derived by `wrap bench` from the 4-robot examples (their "
-         "first robots kept; written to `projects/` in the output folder). A missing point: no "
-         "run of it solved (see the table).");
+    Para(
+        "Time to first task plan (mean of the solved runs, log scale) of the cross (two-finger "
+        "grippers) and the 2x2x3 cube (vacuum) with the first 2, 3 and 4 of their robots, "
+        "without wrench checks, with gravity only, and with the mating wrench scaled by λ. The "
+        "2- and 3-robot projects are derived by `wrap bench` from the 4-robot examples (their "
+        "first robots kept; written to `projects/` in the output folder). A missing point: no "
+        "run of it solved (see the table).");
     std::vector<std::string> models = {"no wrench", "gravity only"};
     for (double l : {0.0, 0.01, 0.1, 0.5, 1.0, 2.0}) models.push_back("λ = " + Fmt("%g", l));
     for (const std::string base : {"cross", "cube_2x2x3"}) {
@@ -378,9 +385,10 @@ class ReportBuilder {
       return;
     }
     Heading(2, "Scaling with parts");
-    Para("WRAP's time to first task plan against the number of parts: prefixes of the 2x2x3 "
-         "cube's sequence (4 cubes = 2x2x1, 8 = 2x2x2, 12 = 2x2x3; vacuum) and of the cross (the "
-         "centre and 1 to 6 arms; two-finger), derived by `wrap bench` from the examples.");
+    Para(
+        "WRAP's time to first task plan against the number of parts: prefixes of the 2x2x3 "
+        "cube's sequence (4 cubes = 2x2x1, 8 = 2x2x2, 12 = 2x2x3; vacuum) and of the cross (the "
+        "centre and 1 to 6 arms; two-finger), derived by `wrap bench` from the examples.");
     LinePlot plot;
     plot.title = "Parts scaling";
     plot.x_label = "parts";
@@ -414,9 +422,10 @@ class ReportBuilder {
     const auto runs = Select([](const RunResult& r) { return r.spec.optimize && !r.spec.motion; });
     if (runs.empty()) return;
     Heading(2, "Convergence of `--optimize` (paper Figure \"search_conv\")");
-    Para("Cost of the best plan over time, one line per run, coloured by planner: the first plan "
-         "at `t_init`, then every improvement of the large neighbourhood search until the time "
-         "limit. The table gives the first and the final cost (mean ± std of the solved runs).");
+    Para(
+        "Cost of the best plan over time, one line per run, coloured by planner: the first plan "
+        "at `t_init`, then every improvement of the large neighbourhood search until the time "
+        "limit. The table gives the first and the final cost (mean ± std of the solved runs).");
     std::vector<std::vector<std::string>> rows;
     std::vector<std::string> order = {"cross", "stool", "chair"};
     for (const RunResult* r : runs) {
@@ -465,10 +474,11 @@ class ReportBuilder {
     const auto runs = Select([](const RunResult& r) { return r.spec.sim; });
     if (runs.empty()) return;
     Heading(2, "Simulation of the wrench ablation (paper Table \"wrench_sim\")");
-    Para("Plans with motion under each wrench model, run in MuJoCo by `wrap sim`: how many runs "
-         "found a plan with motion, how many of all runs held in simulation, the mean actions "
-         "completed, the failures, and the mean peak utilisation [%] of the grippers' limits "
-         "(two-finger / vacuum) in transport and insertion; the paper's row after the slash.");
+    Para(
+        "Plans with motion under each wrench model, run in MuJoCo by `wrap sim`: how many runs "
+        "found a plan with motion, how many of all runs held in simulation, the mean actions "
+        "completed, the failures, and the mean peak utilisation [%] of the grippers' limits "
+        "(two-finger / vacuum) in transport and insertion; the paper's row after the slash.");
     std::vector<std::vector<std::string>> rows;
     for (const std::string p : {"cross", "cube", "chair"}) {
       for (const std::string wrench : {"none", "gravity", "full"}) {
@@ -502,7 +512,10 @@ class ReportBuilder {
         };
         const double n = static_cast<double>(cell.size());
         rows.push_back(
-            {PaperProjectName(p), wrench == "none" ? "w/o wrench" : wrench == "gravity" ? "gravity" : "full",
+            {PaperProjectName(p),
+             wrench == "none"      ? "w/o wrench"
+             : wrench == "gravity" ? "gravity"
+                                   : "full",
              std::to_string(planned) + "/" + std::to_string(cell.size()),
              with(Fmt("%.0f", 100.0 * held / n), paper ? paper->success : ""),
              with(Fmt("%.1f", done / n) + "/" + Fmt("%.1f", total / n), paper ? paper->tasks : ""),
@@ -513,10 +526,10 @@ class ReportBuilder {
                   paper ? paper->insertion_2f + " / " + paper->insertion_vac : "")});
       }
     }
-    Table({"assembly", "model", "planned", "success [%] / paper", "tasks / paper",
-           "failures / paper", "transport 2F / vac (ours / paper)",
-           "insertion 2F / vac (ours / paper)"},
-          rows);
+    Table(
+        {"assembly", "model", "planned", "success [%] / paper", "tasks / paper", "failures / paper",
+         "transport 2F / vac (ours / paper)", "insertion 2F / vac (ours / paper)"},
+        rows);
   }
 
   void Failures() {
@@ -554,8 +567,12 @@ std::string ToMarkdown(const std::vector<Block>& blocks) {
   std::ostringstream o;
   for (const Block& b : blocks) {
     switch (b.kind) {
-      case Block::kHeading: o << std::string(b.level, '#') << " " << b.text << "\n\n"; break;
-      case Block::kPara: o << b.text << "\n\n"; break;
+      case Block::kHeading:
+        o << std::string(b.level, '#') << " " << b.text << "\n\n";
+        break;
+      case Block::kPara:
+        o << b.text << "\n\n";
+        break;
       case Block::kTable: {
         o << "|";
         for (const std::string& h : b.header) o << " " << MdCell(h) << " |";
@@ -570,7 +587,9 @@ std::string ToMarkdown(const std::vector<Block>& blocks) {
         o << "\n";
         break;
       }
-      case Block::kFigure: o << "![" << b.text << "](" << b.file << ")\n\n"; break;
+      case Block::kFigure:
+        o << "![" << b.text << "](" << b.file << ")\n\n";
+        break;
     }
   }
   return o.str();
@@ -604,7 +623,9 @@ std::string ToHtml(const std::vector<Block>& blocks) {
       case Block::kHeading:
         o << "<h" << b.level << ">" << HtmlText(b.text) << "</h" << b.level << ">\n";
         break;
-      case Block::kPara: o << "<p>" << HtmlText(b.text) << "</p>\n"; break;
+      case Block::kPara:
+        o << "<p>" << HtmlText(b.text) << "</p>\n";
+        break;
       case Block::kTable:
         o << "<table><tr>";
         for (const std::string& h : b.header) o << "<th>" << HtmlText(h) << "</th>";

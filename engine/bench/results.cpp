@@ -16,8 +16,8 @@ using Json = nlohmann::ordered_json;
 
 // The plan stats a run keeps, in the CSV's order.
 const std::vector<std::string> kStatColumns = {
-    "cost",    "first_cost", "t_init_s", "t_grasp_s",  "t_bwd_s", "t_lp_s",    "t_fwd_s",
-    "t_ik_s",  "t_kf_s",     "t_mp_s",   "t_retime_s", "t_opt_s", "makespan_s"};
+    "cost",   "first_cost", "t_init_s", "t_grasp_s",  "t_bwd_s", "t_lp_s",    "t_fwd_s",
+    "t_ik_s", "t_kf_s",     "t_mp_s",   "t_retime_s", "t_opt_s", "makespan_s"};
 
 const std::vector<std::string> kUtilColumns = {"transport_2f", "transport_vac", "insertion_2f",
                                                "insertion_vac"};
@@ -151,8 +151,8 @@ std::string ResultsCsv(const std::vector<RunResult>& results) {
       s << ",";
       if (auto it = r.stats.find(c); it != r.stats.end()) s << Num(it->second);
     }
-    s << "," << Num(r.peak_rss_mib) << "," << Num(r.wall_s) << "," << r.exit_code << ","
-      << r.signal << ",";
+    s << "," << Num(r.peak_rss_mib) << "," << Num(r.wall_s) << "," << r.exit_code << "," << r.signal
+      << ",";
     if (r.sim_success) s << (*r.sim_success ? 1 : 0);
     s << ",";
     if (r.sim_success) s << r.sim_tasks_completed << "/" << r.sim_tasks_total;

@@ -32,10 +32,9 @@ using Clock = std::chrono::steady_clock;
 volatile std::sig_atomic_t g_interrupted = 0;
 void OnInterrupt(int) { g_interrupted = 1; }
 
-const std::vector<std::string> kStats = {"cost",   "first_cost", "t_init_s", "t_grasp_s",
-                                         "t_bwd_s", "t_lp_s",    "t_fwd_s",  "t_ik_s",
-                                         "t_kf_s",  "t_mp_s",    "t_retime_s", "t_opt_s",
-                                         "makespan_s"};
+const std::vector<std::string> kStats = {
+    "cost",   "first_cost", "t_init_s", "t_grasp_s",  "t_bwd_s", "t_lp_s",    "t_fwd_s",
+    "t_ik_s", "t_kf_s",     "t_mp_s",   "t_retime_s", "t_opt_s", "makespan_s"};
 
 std::string Num(double v) {
   char buf[32];
@@ -59,6 +58,16 @@ bool LogMentions(const fs::path& log, const std::string& what) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str().find(what) != std::string::npos;
+}
+
+// Messages name files by their place in the output folder, not by this machine's paths.
+std::string WithinOutput(std::string message, const fs::path& out) {
+  for (const std::string& prefix : {fs::absolute(out).string() + "/", out.string() + "/"}) {
+    for (size_t at = message.find(prefix); at != std::string::npos; at = message.find(prefix, at)) {
+      message.erase(at, prefix.size());
+    }
+  }
+  return message;
 }
 
 // One child process: the command, its limits and where it writes.
@@ -157,10 +166,10 @@ void ReadPlanStats(RunResult& r, const fs::path& plan_file, std::string& failure
     if (!st.contains(k) || !st[k].is_number()) continue;
     // Cost and its history mean nothing without a plan; the times do.
     if (!solved && (k == "cost" || k == "first_cost" || k == "makespan_s")) continue;
-    if (!st.value("motion", false) && (k == "t_kf_s" || k == "t_mp_s" || k == "t_retime_s" ||
-                                       k == "makespan_s")) {
-      continue;
-    }
+    // Motion times where motion was tried (also when it failed), none for a task-only plan.
+    const bool motion_stat = k == "t_kf_s" || k == "t_mp_s" || k == "t_retime_s";
+    if (motion_stat && !st.value("motion", false) && st[k].get<double>() == 0.0) continue;
+    if (k == "makespan_s" && !st.value("motion", false)) continue;
     r.stats[k] = st[k].get<double>();
   }
   if (solved && st.contains("cost_history") && st["cost_history"].is_array()) {
@@ -248,17 +257,18 @@ RunInfo CollectInfo(const BenchOptions& options, size_t runs) {
   std::string key;
   long long kib = 0;
   mem >> key >> kib;
-  info.machine = model + ", " + std::to_string(std::thread::hardware_concurrency()) +
-                 " cores, " + Num(std::round(kib / 1048576.0)) + " GiB";
+  info.machine = model + ", " + std::to_string(std::thread::hardware_concurrency()) + " cores, " +
+                 Num(std::round(kib / 1048576.0)) + " GiB";
   const std::string host_os = CommandOutput("uname -sr 2>/dev/null");
   if (!host_os.empty()) info.machine += ", " + host_os;
-  info.load = "load average at the start " + LoadAverage();
+  info.load = "at the start " + LoadAverage();
   const fs::path src = fs::absolute(options.projects_dir).parent_path();
   const std::string q = "'" + src.string() + "'";
   info.commit = CommandOutput("git -C " + q + " rev-parse --short HEAD 2>/dev/null");
   if (info.commit.empty()) {
     info.commit = "unknown";
-  } else if (!CommandOutput("git -C " + q + " status --porcelain --untracked-files=no -- engine app 2>/dev/null")
+  } else if (!CommandOutput("git -C " + q +
+                            " status --porcelain --untracked-files=no -- engine app 2>/dev/null")
                   .empty()) {
     info.commit += " (with local changes)";
   }
@@ -277,8 +287,11 @@ RunInfo CollectInfo(const BenchOptions& options, size_t runs) {
 }
 
 Json InfoToJson(const RunInfo& i) {
-  return {{"machine", i.machine}, {"load", i.load},         {"commit", i.commit},
-          {"date", i.date},       {"settings", i.settings}};
+  return {{"machine", i.machine},
+          {"load", i.load},
+          {"commit", i.commit},
+          {"date", i.date},
+          {"settings", i.settings}};
 }
 
 RunInfo InfoFromJson(const Json& j) {
@@ -418,8 +431,8 @@ Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
     }
     job.child = Child{};
     job.child.start = Clock::now();
-    job.child.deadline =
-        job.child.start + std::chrono::milliseconds(static_cast<long long>(1000 * limit_for(job.spec)));
+    job.child.deadline = job.child.start + std::chrono::milliseconds(
+                                               static_cast<long long>(1000 * limit_for(job.spec)));
     job.child.pid = Spawn(argv, log, as_mib);
     return job.child.pid > 0;
   };
@@ -435,10 +448,9 @@ Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
       if (killed) {
         r.sim_success = false;
         r.sim_failure = "sim timeout";
-      } else if (WIFSIGNALED(wstatus) ||
-                 (WIFEXITED(wstatus) && WEXITSTATUS(wstatus) >= 2)) {
+      } else if (WIFSIGNALED(wstatus) || (WIFEXITED(wstatus) && WEXITSTATUS(wstatus) >= 2)) {
         r.sim_success = false;
-        r.sim_failure = "sim error: " + LastLine(log);
+        r.sim_failure = "sim error: " + WithinOutput(LastLine(log), out);
       } else {
         ReadSimReport(r, out / "sims" / (job.key + ".json"));
       }
@@ -459,14 +471,16 @@ Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
       r.signal = WTERMSIG(wstatus);
       r.exit_code = -1;
       r.status = r.signal == SIGKILL ? Status::kOutOfMemory : Status::kCrash;
-      r.message = std::string("signal ") + std::to_string(r.signal) + " (" +
-                  strsignal(r.signal) + ")" + (r.signal == SIGKILL ? ", likely the OOM killer" : "");
+      r.message = std::string("signal ") + std::to_string(r.signal) + " (" + strsignal(r.signal) +
+                  ")" + (r.signal == SIGKILL ? ", likely the OOM killer" : "");
     } else {
       r.exit_code = WEXITSTATUS(wstatus);
       switch (r.exit_code) {
-        case 0: r.status = Status::kSolved; break;
+        case 0:
+          r.status = Status::kSolved;
+          break;
         case 1:
-          r.status = oom                                ? Status::kOutOfMemory
+          r.status = oom ? Status::kOutOfMemory
                      : failure.starts_with("time limit") || LogMentions(log, "time limit ran out")
                          ? Status::kTimeout
                          : Status::kUnsolved;
@@ -483,6 +497,7 @@ Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
           r.message = "exit " + std::to_string(r.exit_code) + ": " + LastLine(log);
       }
     }
+    r.message = WithinOutput(r.message, out);
     if (r.message.size() > 400) r.message = r.message.substr(0, 400) + "...";
     if (r.solved() && job.spec.sim && job.spec.motion) {
       job.sim_phase = true;
@@ -503,10 +518,9 @@ Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
       for (size_t i : running) waitpid(jobs[i].child.pid, nullptr, 0);
       std::signal(SIGINT, old_int);
       std::signal(SIGTERM, old_term);
-      return Fail(ErrorCode::kCancelled,
-                  "interrupted: " + std::to_string(progress.done) + " of " +
-                      std::to_string(progress.total) +
-                      " runs are in " + (out / "runs").string() + "; run again to resume");
+      return Fail(ErrorCode::kCancelled, "interrupted: " + std::to_string(progress.done) + " of " +
+                                             std::to_string(progress.total) + " runs are in " +
+                                             (out / "runs").string() + "; run again to resume");
     }
     while (static_cast<int>(running.size()) < options.jobs && !queue.empty()) {
       const size_t i = queue.back();
@@ -572,8 +586,7 @@ Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
   return results;
 }
 
-Result<std::vector<RunResult>> MergeShards(const std::vector<fs::path>& dirs,
-                                           const fs::path& out) {
+Result<std::vector<RunResult>> MergeShards(const std::vector<fs::path>& dirs, const fs::path& out) {
   if (dirs.empty()) return Fail(ErrorCode::kInvalidInput, "merge: no shard folders given");
   auto results = ReadRunResults(dirs);
   if (!results) return results;

@@ -97,9 +97,9 @@ void ScalingSuite(std::vector<RunSpec>& out, int runs, double limit) {
   }
   // Parts: prefixes of the 2x2x3 cube's sequence (4, 8, 12 cubes) and of the cross (1-6 arms).
   for (int cubes : {4, 6, 8, 10, 12}) {
-    const std::string name = cubes == 12 ? "cube_2x2x3"
-                       : cubes % 4 == 0 ? "cube_2x2x" + std::to_string(cubes / 4)
-                                        : "cube_2x2x3_p" + std::to_string(cubes);
+    const std::string name = cubes == 12      ? "cube_2x2x3"
+                             : cubes % 4 == 0 ? "cube_2x2x" + std::to_string(cubes / 4)
+                                              : "cube_2x2x3_p" + std::to_string(cubes);
     ProjectSpec project{name, "cube_2x2x3", 0, cubes == 12 ? 0 : cubes - 1, "scaling_parts"};
     AddSeeds(out, Spec(project, "wrap", "scaling_parts", limit), runs);
   }
@@ -145,12 +145,18 @@ std::string RunSpec::Key() const {
 
 std::string ToString(Status status) {
   switch (status) {
-    case Status::kSolved: return "solved";
-    case Status::kUnsolved: return "unsolved";
-    case Status::kTimeout: return "timeout";
-    case Status::kOutOfMemory: return "oom";
-    case Status::kCrash: return "crash";
-    case Status::kError: return "error";
+    case Status::kSolved:
+      return "solved";
+    case Status::kUnsolved:
+      return "unsolved";
+    case Status::kTimeout:
+      return "timeout";
+    case Status::kOutOfMemory:
+      return "oom";
+    case Status::kCrash:
+      return "crash";
+    case Status::kError:
+      return "error";
   }
   return "error";
 }
@@ -223,12 +229,11 @@ Result<void> WriteDerivedProject(const ProjectSpec& spec, const std::filesystem:
     return Fail(ErrorCode::kInvalidInput, where + ": not a JSON object");
   }
   j["name"] = spec.name;
-  j["description"] = "Derived by `wrap bench` from '" + spec.base + "'" +
-                     (spec.robots > 0 ? ": its first " + std::to_string(spec.robots) + " robots"
-                                      : "") +
-                     (spec.steps > 0 ? ": its first " + std::to_string(spec.steps) +
-                                           " steps and their parts"
-                                     : "");
+  j["description"] =
+      "Derived by `wrap bench` from '" + spec.base + "'" +
+      (spec.robots > 0 ? ": its first " + std::to_string(spec.robots) + " robots" : "") +
+      (spec.steps > 0 ? ": its first " + std::to_string(spec.steps) + " steps and their parts"
+                      : "");
   if (spec.robots > 0) {
     if (!j.contains("robots") || !j["robots"].is_array() ||
         static_cast<int>(j["robots"].size()) < spec.robots) {

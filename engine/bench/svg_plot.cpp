@@ -46,11 +46,20 @@ std::string XmlEscape(const std::string& s) {
   std::string r;
   for (char c : s) {
     switch (c) {
-      case '&': r += "&amp;"; break;
-      case '<': r += "&lt;"; break;
-      case '>': r += "&gt;"; break;
-      case '"': r += "&quot;"; break;
-      default: r += c;
+      case '&':
+        r += "&amp;";
+        break;
+      case '<':
+        r += "&lt;";
+        break;
+      case '>':
+        r += "&gt;";
+        break;
+      case '"':
+        r += "&quot;";
+        break;
+      default:
+        r += c;
     }
   }
   return r;
@@ -122,8 +131,8 @@ std::string RenderSvg(const LinePlot& plot) {
     if (t < xa - 1e-9 || t > xb + 1e-9) continue;
     o << "<line x1=\"" << F(X(t)) << "\" y1=\"" << top << "\" x2=\"" << F(X(t)) << "\" y2=\""
       << top + ph << "\" stroke=\"#ddd\"/>\n";
-    o << "<text x=\"" << F(X(t)) << "\" y=\"" << F(top + ph + 15)
-      << "\" text-anchor=\"middle\">" << Label(t) << "</text>\n";
+    o << "<text x=\"" << F(X(t)) << "\" y=\"" << F(top + ph + 15) << "\" text-anchor=\"middle\">"
+      << Label(t) << "</text>\n";
   }
   for (double t : yticks) {
     o << "<line x1=\"" << left << "\" y1=\"" << F(Y(t)) << "\" x2=\"" << left + pw << "\" y2=\""

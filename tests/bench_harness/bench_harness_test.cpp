@@ -263,8 +263,8 @@ TEST(BenchCli, BadInputExitsTwoNamingTheProblem) {
   std::string err;
   EXPECT_EQ(RunWrap("bench --suite nope -o '" + tmp.path().string() + "/o'", tmp.path(), &err), 2);
   EXPECT_NE(err.find("--suite"), std::string::npos) << err;
-  EXPECT_EQ(RunWrap("bench --suite tiny --shard 3/2 -o '" + tmp.path().string() + "/o'",
-                    tmp.path(), &err),
+  EXPECT_EQ(RunWrap("bench --suite tiny --shard 3/2 -o '" + tmp.path().string() + "/o'", tmp.path(),
+                    &err),
             2);
   EXPECT_NE(err.find("--shard"), std::string::npos) << err;
   EXPECT_EQ(RunWrap("bench --suite tiny", tmp.path(), &err), 2);
@@ -274,8 +274,7 @@ TEST(BenchCli, BadInputExitsTwoNamingTheProblem) {
                     tmp.path(), &err),
             2);
   EXPECT_NE(err.find("cross.json"), std::string::npos) << err;
-  EXPECT_EQ(RunWrap("bench merge '" + tmp.path().string() + "' -o '" + tmp.path().string() +
-                        "/m'",
+  EXPECT_EQ(RunWrap("bench merge '" + tmp.path().string() + "' -o '" + tmp.path().string() + "/m'",
                     tmp.path(), &err),
             2);
   EXPECT_NE(err.find("runs"), std::string::npos) << err;
@@ -363,8 +362,8 @@ TEST(BenchRunner, ShardsMergedEqualTheUnshardedRun) {
   ASSERT_EQ(b.size(), a.size());
   ASSERT_EQ(a[0], b[0]);
   for (size_t i = 1; i < a.size(); ++i) {
-    for (const char* c : {"project", "planner", "options", "seed", "status", "solved", "cost",
-                          "first_cost"}) {
+    for (const char* c :
+         {"project", "planner", "options", "seed", "status", "solved", "cost", "first_cost"}) {
       const int k = Column(a[0], c);
       EXPECT_EQ(a[i][k], b[i][k]) << "row " << i << " column " << c;
     }
