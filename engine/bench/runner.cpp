@@ -431,8 +431,11 @@ Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
     }
     job.child = Child{};
     job.child.start = Clock::now();
-    job.child.deadline = job.child.start + std::chrono::milliseconds(
-                                               static_cast<long long>(1000 * limit_for(job.spec)));
+    // Simulating a plan takes longer than planning it on a slow machine (MuJoCo steps through
+    // the whole makespan): the sim child gets four times the plan's limit.
+    const double limit_s = limit_for(job.spec) * (job.sim_phase ? 4.0 : 1.0);
+    job.child.deadline =
+        job.child.start + std::chrono::milliseconds(static_cast<long long>(1000 * limit_s));
     job.child.pid = Spawn(argv, log, as_mib);
     return job.child.pid > 0;
   };
@@ -447,7 +450,7 @@ Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
     if (job.sim_phase) {
       if (killed) {
         r.sim_success = false;
-        r.sim_failure = "sim timeout";
+        r.sim_failure = "sim killed at the hard limit";
       } else if (WIFSIGNALED(wstatus) || (WIFEXITED(wstatus) && WEXITSTATUS(wstatus) >= 2)) {
         r.sim_success = false;
         r.sim_failure = "sim error: " + WithinOutput(LastLine(log), out);
@@ -598,20 +601,22 @@ Result<std::vector<RunResult>> MergeShards(const std::vector<fs::path>& dirs, co
       return std::unexpected(w.error());
     }
   }
-  // The report names every shard's machine, commit and date.
+  // The report names every folder's machine, commit, date, load and settings.
   RunInfo info;
-  std::set<std::string> machines, commits, dates, settings, loads;
+  std::set<std::string> machines, commits, dates;
+  std::string loads, settings;
   for (const fs::path& d : dirs) {
     auto text = ReadFile(d / "meta.json");
     if (!text) continue;
     const Json j = Json::parse(*text, nullptr, false);
     if (j.is_discarded() || !j.is_object()) continue;
     const RunInfo i = InfoFromJson(j);
+    const std::string name = fs::absolute(d).lexically_normal().filename().string();
     machines.insert(i.machine);
     commits.insert(i.commit);
     dates.insert(i.date);
-    settings.insert(i.settings);
-    loads.insert(i.load);
+    loads += (loads.empty() ? "" : "; ") + name + ": " + i.load;
+    settings += (settings.empty() ? "" : "; ") + name + ": " + i.settings;
   }
   const auto join = [](const std::set<std::string>& s) {
     std::string r;
@@ -620,9 +625,12 @@ Result<std::vector<RunResult>> MergeShards(const std::vector<fs::path>& dirs, co
   };
   info.machine = join(machines);
   info.commit = join(commits);
-  info.date = join(dates);
-  info.load = join(loads);
-  info.settings = "merged from " + std::to_string(dirs.size()) + " folder(s): " + join(settings);
+  info.date = dates.empty() ? "unknown"
+              : dates.size() == 1
+                  ? *dates.begin()
+                  : *dates.begin() + " to " + *dates.rbegin() + " (the folders' starts)";
+  info.load = loads.empty() ? "unknown" : loads;
+  info.settings = "merged from " + std::to_string(dirs.size()) + " folder(s): " + settings;
   if (auto w = WriteFileAtomic(out / "meta.json", InfoToJson(info).dump(2) + "\n"); !w) {
     return std::unexpected(w.error());
   }

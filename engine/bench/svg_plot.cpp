@@ -67,7 +67,7 @@ std::string XmlEscape(const std::string& s) {
 
 std::string RenderSvg(const LinePlot& plot) {
   const double W = plot.width_px, H = plot.height_px;
-  const double left = 62, right = 150, top = 30, bottom = 46;
+  const double left = 62, right = 180, top = 30, bottom = 46;
   const double pw = W - left - right, ph = H - top - bottom;
 
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;

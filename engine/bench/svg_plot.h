@@ -27,7 +27,7 @@ struct LinePlot {
   bool log_y = false;              ///< Logarithmic y axis (points with y <= 0 are left out).
   std::vector<double> x_ticks;     ///< Fixed x ticks; empty: automatic.
   std::vector<PlotSeries> series;  ///< The lines.
-  int width_px = 560;              ///< Image size [px].
+  int width_px = 620;              ///< Image size [px].
   int height_px = 340;             ///< Image size [px].
 };
 
