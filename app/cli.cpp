@@ -116,9 +116,12 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   CLI::App* sim = app.add_subcommand(
       "sim", "Run a plan in MuJoCo: does it hold, gripper utilisation, failure (paper V-B)");
   sim->add_option("PROJECT", sim_args.project, "Project file (.json)")->required();
-  sim->add_option("--plan", sim_args.plan, "Plan file with motion (.json)")->required();
+  sim->add_option("--plan", sim_args.plan,
+                  "Plan file (.json); without motion its keyframes are replayed")
+      ->required();
   sim->add_option("-o,--output", sim_args.output, "Write the report JSON to this file (atomic)");
-  sim->add_option("--video", sim_args.video, "Record the run as an MP4 (not implemented yet)");
+  sim->add_option("--video", sim_args.video,
+                  "Record the simulated run as an MP4 (offscreen renderer, needs ffmpeg)");
   sim->add_option("--force-scale", sim_args.force_scale,
                   "Scale lambda on the applied mating wrench (default 1)")
       ->check(CLI::NonNegativeNumber);

@@ -102,14 +102,16 @@ struct SimArgs {
   std::string project;       ///< Project file.
   std::string plan;          ///< --plan PLAN.json (with motion).
   std::string output;        ///< -o REPORT.json (atomic); empty: not written.
-  std::string video;         ///< --video FILE.mp4 (not implemented yet: exit 2).
+  std::string video;         ///< --video FILE.mp4: the simulated run drawn and encoded (ffmpeg).
   double force_scale = 1.0;  ///< --force-scale lambda on the applied mating wrench.
   std::string mjcf_dir;      ///< --mjcf DIR: also write the physics model there.
 };
 
-/// `wrap sim PROJECT --plan PLAN [-o REPORT.json]`: runs the plan in MuJoCo (paper V-B) and
-/// reports whether it holds, the grippers' peak utilisations and the failure; exit 0 holds,
-/// 1 fails, 2 bad input, 3 internal (a MuJoCo error).
+/// `wrap sim PROJECT --plan PLAN [-o REPORT.json] [--video FILE.mp4]`: runs the plan in MuJoCo
+/// (paper V-B; a plan without motion replays its keyframes) and reports whether it holds, the
+/// grippers' peak utilisations and the failure, optionally recording the run as a video; exit 0
+/// holds, 1 fails, 2 bad input (also: no renderer or ffmpeg for --video, said before the run),
+/// 3 internal (a MuJoCo error).
 int Sim(const SimArgs& args, std::ostream& out, std::ostream& err);
 
 /// Arguments of `wrap bench` and `wrap bench merge`.

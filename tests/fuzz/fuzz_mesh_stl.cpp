@@ -1,0 +1,6 @@
+// libFuzzer target: ImportMesh on bytes written as a .stl file (see fuzz_targets.h).
+#include "fuzz_targets.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  return wrap::fuzz::FuzzMesh(data, size, ".stl");
+}
