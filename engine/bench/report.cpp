@@ -381,13 +381,14 @@ class ReportBuilder {
           });
           const Stat t = Summarise(Values(cell, "t_init_s"));
           if (t.n > 0) s.points.emplace_back(robots, std::max(t.mean, 1e-3));
-          row.push_back(cell.empty() ? "–" : MeanStd(t) + " (" + SolvedCell(cell) + ")");
+          row.push_back(cell.empty() ? "–" : MeanStd(t) + " [" + SolvedCell(cell) + "]");
         }
         rows.push_back(row);
         plot.series.push_back(s);
       }
       Figure("fig_scaling_robots_" + base + ".svg", plot.title, plot);
-      Table({base + ": wrench model", "2 robots: t_init (solved)", "3 robots", "4 robots"}, rows);
+      Table({base + ": wrench model", "2 robots: t_init [s] [solved]", "3 robots", "4 robots"},
+            rows);
     }
   }
 

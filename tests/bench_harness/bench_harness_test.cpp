@@ -426,3 +426,87 @@ TEST(BenchSvg, PlotsHaveAxesLinesAndLegend) {
 
 }  // namespace
 }  // namespace wrap::bench
+
+namespace wrap::bench {
+namespace {
+
+RunResult Synthetic(const ProjectSpec& project, const std::string& planner, std::uint64_t seed,
+                    double t_init, double cost) {
+  RunResult r;
+  r.spec.project = project;
+  r.spec.group = project.group;
+  r.spec.planner = planner;
+  r.spec.seed = seed;
+  r.spec.time_limit_s = 20.0;
+  r.status = Status::kSolved;
+  r.stats = {{"t_init_s", t_init}, {"cost", cost}, {"first_cost", cost}, {"t_grasp_s", 0.1}};
+  r.cost_history = {{t_init, cost}};
+  return r;
+}
+
+// Every section of the report from results made up here: the scaling and convergence figures,
+// the simulation table with the paper's row, means and the paper's numbers.
+TEST(BenchReport, SectionsFiguresAndThePapersNumbers) {
+  TempDir tmp;
+  std::vector<RunResult> results;
+  // Comparison: WRAP on the cross, 2 seeds, 1.0 and 3.0 s.
+  results.push_back(Synthetic({"cross", "cross", 0, 0, "comparison"}, "wrap", 0, 1.0, 24));
+  results.push_back(Synthetic({"cross", "cross", 0, 0, "comparison"}, "wrap", 1, 3.0, 26));
+  // Scaling: the cross with 2 robots under no wrench; a prefix of the cube.
+  RunResult r2 = Synthetic({"cross_r2", "cross", 2, 0, "scaling_robots"}, "wrap", 0, 0.5, 30);
+  r2.spec.wrench = "none";
+  results.push_back(r2);
+  results.push_back(
+      Synthetic({"cube_2x2x1", "cube_2x2x3", 0, 3, "scaling_parts"}, "wrap", 0, 0.7, 20));
+  // Convergence: an --optimize run improving 30 -> 25.
+  RunResult opt = Synthetic({"stool", "stool", 0, 0, "convergence"}, "wrap", 0, 2.0, 25);
+  opt.spec.optimize = true;
+  opt.stats["first_cost"] = 30;
+  opt.cost_history = {{2.0, 30}, {9.0, 25}};
+  results.push_back(opt);
+  // Ablation: the cross with full wrench, simulated, holds.
+  RunResult sim = Synthetic({"cross", "cross", 0, 0, "ablation"}, "wrap", 0, 1.5, 22);
+  sim.spec.motion = sim.spec.sim = true;
+  sim.sim_success = true;
+  sim.sim_tasks_completed = sim.sim_tasks_total = 22;
+  sim.sim_util = {{"transport_2f", 40}, {"insertion_2f", 30}};
+  results.push_back(sim);
+  // A timeout.
+  RunResult t = Synthetic({"chair", "chair", 0, 0, "comparison"}, "flat", 0, 0, 0);
+  t.status = Status::kTimeout;
+  t.stats.clear();
+  t.message = "killed by the harness";
+  results.push_back(t);
+
+  RunInfo info{"test machine", "load 0", "abc1234", "2026-01-01", "test"};
+  ASSERT_TRUE(WriteReport(results, info, tmp.path()).has_value());
+  for (const char* f : {"fig_scaling_robots_cross.svg", "fig_scaling_robots_cube_2x2x3.svg",
+                        "fig_scaling_parts.svg", "fig_convergence_stool.svg"}) {
+    EXPECT_TRUE(fs::exists(tmp.path() / f)) << f;
+  }
+  const std::string md = Slurp(tmp.path() / "report.md");
+  EXPECT_NE(md.find("abc1234"), std::string::npos);
+  // Mean ± sample std of 1 and 3 s, the paper's 2.01 s and the ratio 2.0 / 2.01.
+  EXPECT_NE(md.find("| Cross | Ours (WRAP) | 2/2 | 2.00 ± 1.41 | 2.01 | 0.995 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| Chair | Flat lazy | 0/1 (timeout 1) | – | OOM |"), std::string::npos);
+  EXPECT_NE(md.find("![Cross, two-finger grippers](fig_scaling_robots_cross.svg)"),
+            std::string::npos);
+  EXPECT_NE(md.find("| no wrench | 0.50 (1 run) [1/1] |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| cube_2x2x1 | 4 | 1/1 |"), std::string::npos);
+  EXPECT_NE(md.find("| Stool | Ours (WRAP) | 1/1 | 30.0 (1 run) | 25.0 (1 run) |"),
+            std::string::npos);
+  EXPECT_NE(md.find("| Cross | full | 1/1 | 100 / 100 | 22.0/22.0 / 22/22 | -- / -- | 40 / 25 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("killed by the harness"), std::string::npos);
+  const std::string conv = Slurp(tmp.path() / "fig_convergence_stool.svg");
+  EXPECT_NE(conv.find("Ours (WRAP)"), std::string::npos);
+  EXPECT_NE(conv.find(" V"), std::string::npos);  // the improvement is a step down
+  const std::string html = Slurp(tmp.path() / "report.html");
+  EXPECT_NE(html.find("<figure><svg"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace wrap::bench
