@@ -314,7 +314,14 @@ Result<Chain> Importer::Run(const urdf::ModelInterface& model) {
   // urdfdom keeps the last parent of a link with two: a closed loop it does not report.
   std::map<std::string, std::vector<std::string>> parents_of;
   for (const auto& [name, joint] : model.joints_) {
-    if (joint) parents_of[joint->child_link_name].push_back(name);
+    if (!joint) continue;
+    parents_of[joint->child_link_name].push_back(name);
+    // urdfdom accepts a joint from a link to itself and leaves that link (and what hangs below
+    // it) off the tree from the root without a word (found by fuzzing: tests/fuzz/regressions).
+    if (joint->child_link_name == joint->parent_link_name) {
+      return Invalid("closed loop: joint '" + name + "' connects link '" + joint->child_link_name +
+                     "' to itself; only trees (serial chains) are supported");
+    }
   }
   for (const auto& [link, joints] : parents_of) {
     if (joints.size() > 1) {
@@ -467,6 +474,16 @@ Result<Chain> ImportUrdf(const std::filesystem::path& file, const UrdfImportOpti
         "urdf '" + file.string() + "': urdfdom: " +
             (errors.empty() ? std::string("could not parse the file") : Join(errors, "; ")));
   }
+  // urdfdom links hold their children by shared_ptr, so a link that is its own child (a joint
+  // from a link to itself) would keep the model alive forever: cut those references when done.
+  struct BreakCycles {
+    urdf::ModelInterface& model;
+    ~BreakCycles() {
+      for (auto& [name, link] : model.links_) {
+        if (link) link->child_links.clear();
+      }
+    }
+  } break_cycles{*model};
   Importer importer(file, options);
   try {
     return importer.Run(*model);
