@@ -1,6 +1,7 @@
 #include "core/file_io.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -28,7 +29,51 @@ Result<std::string> ReadFile(const fs::path& path) {
   return ss.str();
 }
 
+namespace {
+
+/// Writes all of `contents` to `fd`; false with errno set on failure.
+bool WriteAll(int fd, const std::string& contents) {
+  const char* p = contents.data();
+  size_t left = contents.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    p += n;
+    left -= static_cast<size_t>(n);
+  }
+  return true;
+}
+
+/// Writes to a character device (`-o /dev/null`, `/dev/full`, a terminal) in place: renaming a
+/// temporary file over it would replace the device node with a regular file.
+Result<void> WriteDevice(const fs::path& path, const std::string& contents) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) {
+    return Fail(ErrorCode::kIo, "cannot open '" + path.string() + "': " + std::strerror(errno));
+  }
+  const bool written = WriteAll(fd, contents);
+  const int write_errno = errno;
+  ::close(fd);
+  if (!written) {
+    return Fail(ErrorCode::kIo,
+                "cannot write '" + path.string() + "': " + std::strerror(write_errno));
+  }
+  return {};
+}
+
+}  // namespace
+
 Result<void> WriteFileAtomic(const fs::path& path, const std::string& contents) {
+  struct stat target {};
+  if (::stat(path.c_str(), &target) == 0 && !S_ISREG(target.st_mode)) {
+    if (S_ISCHR(target.st_mode)) return WriteDevice(path, contents);
+    return Fail(ErrorCode::kIo,
+                "cannot write '" + path.string() + "': " +
+                    (S_ISDIR(target.st_mode) ? "it is a directory" : "it is not a regular file"));
+  }
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::random_device rd;
   const fs::path tmp = dir / ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) +
@@ -37,19 +82,11 @@ Result<void> WriteFileAtomic(const fs::path& path, const std::string& contents) 
   if (fd < 0) {
     return Fail(ErrorCode::kIo, "cannot create '" + tmp.string() + "': " + std::strerror(errno));
   }
-  const char* p = contents.data();
-  size_t left = contents.size();
-  while (left > 0) {
-    const ssize_t n = ::write(fd, p, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const std::string why = std::strerror(errno);
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      return Fail(ErrorCode::kIo, "cannot write '" + tmp.string() + "': " + why);
-    }
-    p += n;
-    left -= static_cast<size_t>(n);
+  if (!WriteAll(fd, contents)) {
+    const std::string why = std::strerror(errno);
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    return Fail(ErrorCode::kIo, "cannot write '" + tmp.string() + "': " + why);
   }
   // Always close, even when fsync fails, so the descriptor never leaks.
   const bool synced = ::fsync(fd) == 0;
