@@ -1,0 +1,209 @@
+// Saving a project or writing results where the write cannot succeed (an unwritable folder, a
+// "folder" that is a regular file, a full disk, a file-size limit): the call fails with a message
+// naming the path, the previous file stays byte-for-byte intact and no temporary file is left.
+//
+// CI runs as root, where permission bits do not stop writes: the unwritable-folder case only runs
+// for other users, and the parent-is-a-file, disk-full (a character device like /dev/full) and
+// file-size-limit (RLIMIT_FSIZE, EFBIG) cases stand in for it everywhere.
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <string>
+#include <vector>
+
+#include "core/file_io.h"
+#include "model/project_io.h"
+#include "reliability_fixture.h"
+
+namespace wrap::reliability {
+namespace {
+
+using cli::CliRun;
+using cli::Wrap;
+
+/// The blocks project, parsed.
+Project Blocks() {
+  ProjectParse parsed = ParseProject(BlocksProject().dump(), "blocks.json");
+  EXPECT_TRUE(parsed.project.has_value());
+  return parsed.project.value_or(Project{});
+}
+
+/// A saved project file and its bytes, to compare with after a failed save.
+struct Previous {
+  fs::path file;
+  std::string bytes;
+};
+
+Previous SaveOriginal(const fs::path& dir) {
+  Project p = Blocks();
+  p.name = "original";
+  const fs::path file = dir / "project.json";
+  EXPECT_TRUE(SaveProject(p, file).has_value());
+  return {file, ReadBytes(file)};
+}
+
+/// The project to save over the original: bigger than it, so that a size limit between the two
+/// stops the write half way.
+Project Edited() {
+  Project p = Blocks();
+  p.name = "edited";
+  p.description = std::string(20000, 'x');
+  return p;
+}
+
+void ExpectIntact(const Previous& prev, const fs::path& dir) {
+  EXPECT_EQ(ReadBytes(prev.file), prev.bytes) << prev.file << " changed";
+  EXPECT_EQ(ListFiles(dir), std::vector<std::string>{"project.json"})
+      << "a temporary file was left in " << dir;
+}
+
+/// Holds RLIMIT_FSIZE at `bytes` (SIGXFSZ ignored, so writes fail with EFBIG) until destroyed.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &old_);
+    old_handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = old_;
+    limit.rlim_cur = bytes;
+    ok_ = setrlimit(RLIMIT_FSIZE, &limit) == 0;
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &old_);
+    std::signal(SIGXFSZ, old_handler_);
+  }
+  bool ok() const { return ok_; }
+
+ private:
+  rlimit old_{};
+  void (*old_handler_)(int) = SIG_DFL;
+  bool ok_ = false;
+};
+
+/// A character device that behaves like /dev/full (writes fail with ENOSPC) at a path of our own
+/// when we may create one (root), else /dev/full itself (other users cannot replace it).
+fs::path DiskFullDevice(const fs::path& dir) {
+  if (::geteuid() == 0) {
+    const fs::path own = dir / "full";
+    if (::mknod(own.c_str(), S_IFCHR | 0666, makedev(1, 7)) == 0) return own;
+    return {};
+  }
+  return "/dev/full";
+}
+
+TEST(FileSafety, SaveIntoAFolderThatIsARegularFile) {
+  TempDir dir("parent_is_file");
+  const Previous prev = SaveOriginal(dir.path);
+  auto saved = SaveProject(Edited(), prev.file / "inner.json");
+  ASSERT_FALSE(saved.has_value());
+  EXPECT_EQ(saved.error().code, ErrorCode::kIo);
+  EXPECT_NE(saved.error().message.find("project.json"), std::string::npos) << saved.error().message;
+  ExpectIntact(prev, dir.path);
+}
+
+TEST(FileSafety, SaveIntoAnUnwritableFolder) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root writes whatever the permission bits say";
+  TempDir dir("unwritable");
+  const Previous prev = SaveOriginal(dir.path);
+  fs::permissions(dir.path, fs::perms::owner_read | fs::perms::owner_exec);
+  auto saved = SaveProject(Edited(), prev.file);
+  fs::permissions(dir.path, fs::perms::owner_all);
+  ASSERT_FALSE(saved.has_value());
+  EXPECT_EQ(saved.error().code, ErrorCode::kIo);
+  EXPECT_NE(saved.error().message.find("Permission denied"), std::string::npos)
+      << saved.error().message;
+  ExpectIntact(prev, dir.path);
+}
+
+TEST(FileSafety, SaveStoppedByAFileSizeLimit) {
+  TempDir dir("fsize");
+  const Previous prev = SaveOriginal(dir.path);
+  Result<void> saved;
+  {
+    FileSizeLimit limit(4096);
+    ASSERT_TRUE(limit.ok());
+    saved = SaveProject(Edited(), prev.file);
+  }
+  ASSERT_FALSE(saved.has_value());
+  EXPECT_EQ(saved.error().code, ErrorCode::kIo);
+  EXPECT_NE(saved.error().message.find("cannot write"), std::string::npos) << saved.error().message;
+  ExpectIntact(prev, dir.path);
+  // Without the limit the same save goes through.
+  ASSERT_TRUE(SaveProject(Edited(), prev.file).has_value());
+  EXPECT_NE(ReadBytes(prev.file).find("\"edited\""), std::string::npos);
+}
+
+// A device is written in place, never replaced by the temporary file (`-o /dev/null` as root
+// used to turn /dev/null into a regular file); a full disk is an error that names the path.
+TEST(FileSafety, DiskFullDeviceIsWrittenInPlaceAndFails) {
+  TempDir dir("disk_full");
+  const fs::path full = DiskFullDevice(dir.path);
+  if (full.empty()) GTEST_SKIP() << "cannot create a device node here";
+  ASSERT_TRUE(fs::is_character_file(full));
+  auto saved = SaveProject(Edited(), full);
+  ASSERT_FALSE(saved.has_value());
+  EXPECT_EQ(saved.error().code, ErrorCode::kIo);
+  EXPECT_NE(saved.error().message.find(full.string()), std::string::npos) << saved.error().message;
+  EXPECT_NE(saved.error().message.find("No space left"), std::string::npos)
+      << saved.error().message;
+  EXPECT_TRUE(fs::is_character_file(full)) << full << " was replaced";
+  if (::geteuid() == 0) {
+    // And a null device takes the bytes and stays a device.
+    const fs::path null = dir.path / "null";
+    ASSERT_EQ(::mknod(null.c_str(), S_IFCHR | 0666, makedev(1, 3)), 0);
+    EXPECT_TRUE(WriteFileAtomic(null, "bytes").has_value());
+    EXPECT_TRUE(fs::is_character_file(null)) << null << " was replaced";
+  }
+}
+
+TEST(FileSafety, SaveOverADirectoryFails) {
+  TempDir dir("over_dir");
+  const Previous prev = SaveOriginal(dir.path);
+  fs::create_directory(dir.path / "folder");
+  auto saved = SaveProject(Edited(), dir.path / "folder");
+  ASSERT_FALSE(saved.has_value());
+  EXPECT_NE(saved.error().message.find("directory"), std::string::npos) << saved.error().message;
+  EXPECT_TRUE(fs::is_directory(dir.path / "folder"));
+  EXPECT_EQ(ReadBytes(prev.file), prev.bytes);
+}
+
+// The results of `wrap plan -o` and `wrap preprocess -o`: exit 2 naming the path; an earlier
+// result at that path stays as it was.
+TEST(FileSafety, CommandResultsKeepThePreviousFile) {
+  TempDir dir("results");
+  const Previous prev = SaveOriginal(dir.path);  // Stands for an earlier result.
+  const std::string project = cli::Project("half_stool");
+
+  // The parent of the output is a regular file.
+  const std::string under_file = (prev.file / "plan.json").string();
+  CliRun r = Wrap({"plan", project, "--task-only", "-o", under_file});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(under_file), std::string::npos) << r.err;
+  r = Wrap({"preprocess", project, "--grasps", "4", "-o", under_file});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(under_file), std::string::npos) << r.err;
+  ExpectIntact(prev, dir.path);
+
+  // The disk fills up (a file-size limit below the plan's size) while the plan is written.
+  {
+    FileSizeLimit limit(prev.bytes.size() + 16);
+    ASSERT_TRUE(limit.ok());
+    r = Wrap({"plan", project, "--task-only", "-o", prev.file.string()});
+  }
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("project.json"), std::string::npos) << r.err;
+  ExpectIntact(prev, dir.path);
+
+  const fs::path full = DiskFullDevice(dir.path);
+  if (!full.empty()) {
+    r = Wrap({"plan", project, "--task-only", "-o", full.string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("No space left"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::is_character_file(full));
+  }
+}
+
+}  // namespace
+}  // namespace wrap::reliability
