@@ -5,15 +5,48 @@
 #                         and the goal into out/stool/
 #   scripts/dev.sh test   install, build, and run the whole test suite (what CI runs)
 #   scripts/dev.sh build  install and build only
-# BUILD_DIR (default: build) and BUILD_TYPE (default: RelWithDebInfo) may be set.
+#   scripts/dev.sh sanitize     install, build everything with ASan + UBSan (-DWRAP_SANITIZE=ON)
+#                               into build-asan and run the whole test suite there
+#   scripts/dev.sh sanitize-ci  the part of `sanitize` that CI runs: no UI, only the suites in
+#                               SANITIZE_CI_SUITES below (core, model, geometry, robot,
+#                               collision, wrench, the fuzz regression and seed replay)
+# BUILD_DIR (default: build), SANITIZE_BUILD_DIR (default: build-asan) and BUILD_TYPE (default:
+# RelWithDebInfo) may be set.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 mode=${1:-demo}
-BUILD_DIR=${BUILD_DIR:-build}
 BUILD_TYPE=${BUILD_TYPE:-RelWithDebInfo}
 
+# The suites (test binaries, ctest labels) of `sanitize-ci`: the loaders (project JSON, meshes,
+# URDF: model, geometry, robot, and the fuzz corpus replay) and the engine below the planner, which
+# build without the planner, motion, sim or UI libraries. The other suites (task, motion, sim,
+# app and reliability, render, GUI) run under sanitizers only in `sanitize`: building the whole
+# engine with ASan does not fit CI's time budget next to the normal build.
+SANITIZE_CI_SUITES=(core_test model_test geometry_test robot_test robot_no_alloc_test
+  collision_test wrench_test fuzz_replay_test)
+
 bash scripts/install_deps.sh
+case "$mode" in
+  sanitize | sanitize-ci)
+    BUILD_DIR=${SANITIZE_BUILD_DIR:-build-asan}
+    ui=ON
+    [[ "$mode" == sanitize ]] || ui=OFF
+    cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE" -DWRAP_SANITIZE=ON \
+      -DWRAP_BUILD_UI="$ui"
+    if [[ "$mode" == sanitize ]]; then
+      cmake --build "$BUILD_DIR" --parallel "$(nproc)"
+      ctest --test-dir "$BUILD_DIR" --output-on-failure --parallel "$(nproc)"
+    else
+      cmake --build "$BUILD_DIR" --parallel "$(nproc)" --target "${SANITIZE_CI_SUITES[@]}"
+      labels=$(IFS='|'; echo "${SANITIZE_CI_SUITES[*]}")
+      ctest --test-dir "$BUILD_DIR" --output-on-failure --parallel "$(nproc)" -L "^($labels)\$"
+    fi
+    exit 0
+    ;;
+esac
+
+BUILD_DIR=${BUILD_DIR:-build}
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE"
 cmake --build "$BUILD_DIR" --parallel "$(nproc)"
 
@@ -33,7 +66,7 @@ case "$mode" in
     ctest --test-dir "$BUILD_DIR" --output-on-failure --parallel "$(nproc)"
     ;;
   *)
-    echo "usage: scripts/dev.sh [demo|test|build]" >&2
+    echo "usage: scripts/dev.sh [demo|test|build|sanitize|sanitize-ci]" >&2
     exit 2
     ;;
 esac
