@@ -8,8 +8,10 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "gui/document.h"
+#include "model/project_io.h"
 #include "gui_fixture.h"
 #include "render/image.h"
 
@@ -228,6 +230,84 @@ TEST(GuiCli, MissingProjectIsBadInput) {
   const ProcessRun r = WrapUnderXvfb(dir, "nope.json --screenshot x.png");
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("nope.json"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace wrap::gui
+
+namespace wrap::gui {
+namespace {
+
+std::string Slurp(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The GUI killed (SIGKILL, no chance to clean up) while the user edits: the recovery file holds
+// the last edit, the project file is untouched, and opening the project again offers the
+// recovery, which gives back the edited project.
+TEST(GuiCli, KilledWhileEditingTheRecoveryFileHoldsTheLastEdit) {
+  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  const auto dir = ScratchDir("gui_cli_kill");
+  {
+    auto doc = Document::Open(ExampleProject("stool"));
+    ASSERT_TRUE(doc);
+    ASSERT_TRUE(doc->SaveAs(dir / "p.json"));
+  }
+  const std::string saved = Slurp(dir / "p.json");
+  std::ofstream(dir / "edit.wrapscript") << "autosave\n"
+                                         << "set part.seat.mass_kg 0.321\n"
+                                         << "set part.seat.mass_kg 0.654\n"
+                                         << "sleep 600\n";
+  // In the background; the shell that xvfb-run starts leaves its pid and becomes wrap.
+  const std::string cmd = "cd '" + dir.string() +
+                          "' && (xvfb-run -a -s '-screen 0 1600x1000x24' sh -c 'echo $$ > "
+                          "wrap.pid; exec \"" +
+                          WRAP_EXE + "\" p.json --script edit.wrapscript' > wrap.log 2>&1 &)";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const fs::path recovery = dir / "p.json.recovery";
+  auto recovered_mass = [&]() -> double {
+    if (!fs::exists(recovery)) return -1.0;
+    ProjectParse parse = ParseProject(Slurp(recovery), "recovery");
+    if (!parse.project) return -2.0;  // a torn file would show here
+    for (const Part& p : parse.project->parts) {
+      if (p.name == "seat" && p.mass_kg) return *p.mass_kg;
+    }
+    return -3.0;
+  };
+  // Both edits done (the script reports each line as it finishes), then the recovery file
+  // follows; the watchdog only bounds a hang.
+  double mass = -1.0;
+  for (int i = 0; i < 1200; ++i) {
+    if (Slurp(dir / "wrap.log").find("ok 3:") != std::string::npos) {
+      mass = recovered_mass();
+      if (mass == 0.654) break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const std::string pid = Slurp(dir / "wrap.pid");
+  ASSERT_FALSE(pid.empty()) << Slurp(dir / "wrap.log");
+  ASSERT_EQ(std::system(("kill -KILL " + pid).c_str()), 0) << "wrap was not running";
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(mass, 0.654) << Slurp(dir / "wrap.log");
+  EXPECT_EQ(recovered_mass(), 0.654) << "the recovery file after the kill";
+  EXPECT_EQ(Slurp(dir / "p.json"), saved) << "the project file itself is not touched";
+  // Opening again: the recovery is offered and gives the edited project back.
+  EXPECT_TRUE(Document::HasRecovery(dir / "p.json"));
+  auto doc = Document::Open(dir / "p.json");
+  ASSERT_TRUE(doc);
+  ASSERT_TRUE(doc->Recover());
+  bool found = false;
+  for (const Part& p : doc->project().parts) {
+    if (p.name == "seat") {
+      found = true;
+      EXPECT_EQ(p.mass_kg.value_or(0.0), 0.654);
+    }
+  }
+  EXPECT_TRUE(found);
+  EXPECT_TRUE(doc->dirty());
 }
 
 }  // namespace

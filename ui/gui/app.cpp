@@ -25,7 +25,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kAutosavePeriodS = 30.0;  // recovery file at most this old
+// The recovery file follows the document: written once edits have paused for a second, and at
+// least every 30 s during a long run of edits (a drag).
+constexpr double kAutosaveQuietS = 1.0;
+constexpr double kAutosavePeriodS = 30.0;
 
 /// The file that lists recent projects (one per line, newest first).
 fs::path RecentFilesPath() {
@@ -45,7 +48,8 @@ bool IsMeshFile(const fs::path& p) {
 
 class App {
  public:
-  App(platform::Window& window, bool interactive) : win_(window), interactive_(interactive) {
+  App(platform::Window& window, bool interactive)
+      : win_(window), interactive_(interactive), autosave_(interactive) {
     if (interactive_) LoadRecent();
   }
 
@@ -116,10 +120,19 @@ class App {
     Popups();
     UpdateViewport();
     UpdateTitle();
-    if (interactive_ && now - last_autosave_ > kAutosavePeriodS) {
-      last_autosave_ = now;
-      if (auto wrote = s_.doc.WriteRecovery(); !wrote) {
-        s_.Notify("Autosave failed: " + wrote.error().message);
+    if (autosave_) {
+      if (s_.doc.revision() != autosave_revision_) {
+        autosave_revision_ = s_.doc.revision();
+        last_edit_ = now;
+      }
+      const bool quiet = now - last_edit_ >= kAutosaveQuietS;
+      if ((quiet || now - last_autosave_ > kAutosavePeriodS) &&
+          autosave_failed_ != autosave_revision_) {
+        last_autosave_ = now;
+        if (auto wrote = s_.doc.WriteRecovery(); !wrote) {
+          autosave_failed_ = autosave_revision_;  // not again until the next edit
+          s_.Notify("Autosave failed: " + wrote.error().message);
+        }
       }
     }
 
@@ -135,6 +148,8 @@ class App {
   }
 
   bool quit() const { return quit_; }
+  /// Writes the recovery file as edits pause (on in the interactive window).
+  void set_autosave(bool on) { autosave_ = on; }
 
   /// The window's close button: confirm when there are unsaved edits.
   void HandleCloseRequest() {
@@ -553,7 +568,10 @@ class App {
   bool confirm_close_ = false, confirm_open_ = false, confirm_new_ = false;
   bool offer_recovery_ = false;
   bool quit_ = false;
-  double last_time_ = 0.0, last_autosave_ = 0.0;
+  double last_time_ = 0.0, last_autosave_ = 0.0, last_edit_ = 0.0;
+  bool autosave_ = false;
+  unsigned long autosave_revision_ = 0;
+  unsigned long autosave_failed_ = ~0UL;
 };
 
 int WriteScreenshot(const render::Image& image, const fs::path& file, std::ostream& out,
@@ -648,9 +666,15 @@ int RunGui(const GuiOptions& options, std::ostream& out, std::ostream& err) {
         code = 1;
         break;
       }
+      if (effect->autosave) app.set_autosave(true);
       if (effect->wait_for_planner) {
         while (s.job.running()) app.Frame(nullptr);
         app.TakePlan();
+      }
+      if (effect->sleep_s > 0) {
+        const auto until = std::chrono::steady_clock::now() +
+                           std::chrono::duration<double>(effect->sleep_s);
+        while (std::chrono::steady_clock::now() < until) app.Frame(nullptr);
       }
       app.Frame(nullptr);
       if (!effect->screenshot.empty()) {
@@ -663,7 +687,7 @@ int RunGui(const GuiOptions& options, std::ostream& out, std::ostream& err) {
       }
       out << "ok " << line.number << ":";
       for (const std::string& w : line.words) out << " " << w;
-      out << "\n";
+      out << std::endl;  // flushed: a watching process sees each line as it is done
     }
     if (!options.screenshot.empty()) {
       render::Image image;

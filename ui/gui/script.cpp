@@ -23,7 +23,7 @@ const std::map<std::string, std::pair<int, int>>& Arity() {
       {"option", {2, 2}},        {"run", {0, 0}},       {"wait", {0, 0}},
       {"expect-plan", {0, 0}},   {"scrub", {1, 1}},     {"play", {0, 0}},
       {"pause", {0, 0}},         {"save", {0, 1}},      {"screenshot", {1, 1}},
-      {"expect-refused", {1, 6}}};
+      {"expect-refused", {1, 6}}, {"autosave", {0, 0}},  {"sleep", {1, 1}}};
   return arity;
 }
 
@@ -309,6 +309,17 @@ Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const 
   if (cmd == "save") {
     auto saved = w.size() > 1 ? app.doc.SaveAs(resolve(w[1])) : app.doc.Save();
     if (!saved) return LineError(line, saved.error().message);
+    return effect;
+  }
+  if (cmd == "autosave") {
+    effect.autosave = true;
+    return effect;
+  }
+  if (cmd == "sleep") {
+    auto seconds = Number(line, w[1]);
+    if (!seconds) return std::unexpected(seconds.error());
+    if (*seconds < 0 || *seconds > 3600) return LineError(line, "sleep wants 0 to 3600 seconds");
+    effect.sleep_s = *seconds;
     return effect;
   }
   if (cmd == "screenshot") {

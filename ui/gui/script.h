@@ -22,6 +22,9 @@
 //   scrub T | play | pause             the timeline [s, or keyframe index without motion]
 //   save [FILE] | screenshot FILE      (relative to the script's folder)
 //   expect-refused COMMAND...          run COMMAND and fail unless it is refused
+//   autosave                           write the recovery file as the interactive window does
+//                                      (off in scripts otherwise, so that they leave none)
+//   sleep SECONDS                      keep drawing frames for that long
 #pragma once
 
 #include <filesystem>
@@ -47,6 +50,8 @@ Result<std::vector<ScriptLine>> ParseScript(const std::string& text);
 struct ScriptEffect {
   bool wait_for_planner = false;     ///< Hold the script until the planner ends.
   std::filesystem::path screenshot;  ///< Save the window to this file at the next frame.
+  bool autosave = false;             ///< Turn the recovery autosave on.
+  double sleep_s = 0.0;              ///< Keep drawing frames this long before the next line.
 };
 
 /// Runs one line against `app`; relative paths resolve against `base_dir`. A refused edit fails
