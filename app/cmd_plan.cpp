@@ -1,3 +1,4 @@
+#include <chrono>
 #include <cstdio>
 #include <optional>
 #include <ostream>
@@ -135,7 +136,10 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   pipeline.task = options;
   pipeline.task_only = args.task_only;
   pipeline.seed = seed;
+  const auto t_plan = std::chrono::steady_clock::now();
   auto plan = PlanAssembly(p, loaded.check, *pre, pipeline, ctx);
+  const double t_planning =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_plan).count();
   if (!plan) {
     err << args.project << ": " << plan.error().message << "\n";
     return ExitCodeFor(plan.error().code);
@@ -166,7 +170,7 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
       out << "\n";
     }
   } else {
-    err << "No plan found in " << Fmt("%.1f", st.t_init_s) << " s: " << st.failure << "\n";
+    err << "No plan found in " << Fmt("%.1f", t_planning) << " s: " << st.failure << "\n";
   }
 
   if (!args.output.empty()) {

@@ -1,10 +1,18 @@
 #include "core/run_context.h"
 
+#include <ctime>
+
 #include <unistd.h>
 
 #include <cstdio>
 
 namespace wrap {
+
+double ThreadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 void RunContext::set_time_limit_s(double seconds) {
   if (!(seconds > 0.0) || seconds > 1e9) {

@@ -12,6 +12,11 @@
 
 namespace wrap {
 
+/// CPU time the calling thread has used [s]. Budgets of inner searches (a path query, a carry
+/// search) count it rather than wall-clock time, so that a loaded machine slows them down but
+/// does not change what they find; the run's own deadline stays wall-clock.
+double ThreadCpuSeconds();
+
 /// Per-stage wall-clock totals [s], keyed by stage name (e.g. "grasp", "fwd_search").
 using StageTimes = std::map<std::string, double>;
 

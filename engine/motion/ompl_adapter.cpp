@@ -17,6 +17,7 @@
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
 #include <ompl/util/Console.h>
 
+#include "core/run_context.h"
 namespace wrap {
 
 namespace ob = ompl::base;
@@ -237,11 +238,11 @@ PathAnswer PlanPath(const PathQuery& query) {
   planner->setRange(query.range_per_sqrt_dim * std::sqrt(static_cast<double>(dim)));
   planner->setProblemDefinition(pdef);
   planner->setup();
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(query.time_limit_s));
+  // The budget is this thread's CPU time (a loaded machine slows the search, it does not cut
+  // it short); cancellation and the run's deadline come through query.stop.
+  const double cpu_deadline = ThreadCpuSeconds() + query.time_limit_s;
   ob::PlannerTerminationCondition ptc(
-      [&] { return std::chrono::steady_clock::now() >= deadline || (query.stop && query.stop()); });
+      [&] { return ThreadCpuSeconds() >= cpu_deadline || (query.stop && query.stop()); });
   std::uint64_t attempt_seed = seed;
   while (true) {
     const ob::PlannerStatus status = planner->solve(ptc);

@@ -28,7 +28,7 @@ struct PathQuery {
   /// The returned path is checked at this finer resolution (shortcuts too); a path that fails
   /// it is not returned. 0: the same as `resolution`.
   double final_resolution = 0.0;
-  double time_limit_s = 1.0;  ///< RRT-Connect's budget [s].
+  double time_limit_s = 1.0;  ///< RRT-Connect's budget: CPU time of the calling thread [s].
   std::uint64_t seed = 0;     ///< Seeds sampling and shortcutting (deterministic per seed).
   /// Checked while planning: true stops at once (cancellation).
   std::function<bool()> stop;

@@ -120,7 +120,14 @@ class Builder {
   // Whether robot r at q is in a tight pocket: more than one in eight small perturbations of its
   // joints (kTightRad) collide in the current scene.
   bool Tight(int robot, const JointVector& q);
+  // Everything a free path's validity depends on besides its own robots' start and goal: every
+  // robot's joints, the objects' poses, the holds, grasps and finger openings.
+  std::vector<double> SceneKey() const;
   bool Retreat(int action, int robot);
+  // Sets robot's finger opening for a free move toward a grasp: `wanted`, unless the fingers at
+  // `wanted` hit something where the robot stands and at their present opening do not (then
+  // they stay). False when the scene cannot be set.
+  bool MoveOpening(int robot, double wanted);
   // Free motion of `robots` to `goals`. With `others` (one robot only): other goals that serve
   // as well; *reached tells which was reached (0: goals[0], k: others[k - 1]).
   bool Free(int action, bool main, const std::vector<int>& robots,
@@ -129,6 +136,25 @@ class Builder {
   bool Lift(int action, int node, const std::vector<int>& holders);
   bool Carry(int action, int node, const std::vector<int>& holders, const Iso3& X_goal,
              std::vector<JointVector> goal_q, const Keyframe& target, bool approach);
+  // The end of a carry: the holders' last joints `last` snapped to their keyframe joints
+  // `goal_q` (or to an equivalent turn), or accepted as another IK solution that fits `target`
+  // (added to `rebranch`); false with `why` otherwise.
+  bool CarryEnd(const std::vector<int>& holders, const std::vector<JointVector>& goal_q,
+                const Keyframe& target, std::vector<JointVector>& last,
+                std::vector<std::pair<size_t, JointVector>>& rebranch, std::string& why);
+  // The holders' joints along the object moving from X_a to X_b (translation straight, rotation
+  // by slerp), tracked from q0 and collision-free in the current scene; empty when an arm
+  // cannot follow or something is hit.
+  std::vector<std::vector<JointVector>> CarryEdge(const std::vector<int>& holders,
+                                                  const std::vector<JointVector>& q0,
+                                                  const Iso3& X_a, const Iso3& X_b);
+  // A carry the straight variants could not make: a tree of object poses grown from the start
+  // (RRT with goal bias, each edge tracked by the holders' IK and checked for collisions), then
+  // shortcut. Budget: segment_time_s * 2^effort. The path on success (empty otherwise).
+  std::vector<std::vector<JointVector>> CarrySearch(
+      const std::vector<int>& holders, const Iso3& X_start, const Iso3& X_goal,
+      const std::vector<JointVector>& goal_q, const Keyframe& target,
+      std::vector<std::pair<size_t, JointVector>>& rebranch, double* length, std::string& why);
   bool Action(int index);
   bool Return(int action, int robot, const JointVector& goal, bool main);
   // Robot r at `q` instead of its joints at the keyframe `kf` (same TCP): collision-free and
@@ -372,6 +398,27 @@ bool Builder::PathClear(const std::vector<int>& robots,
   return true;
 }
 
+std::vector<double> Builder::SceneKey() const {
+  std::vector<double> key;
+  for (const JointVector& q : cur_) key.insert(key.end(), q.data(), q.data() + q.size());
+  key.insert(key.end(), opening_.begin(), opening_.end());
+  for (int r : released_) key.push_back(r);
+  for (const auto& [node, o] : state_.objects) {
+    key.push_back(node);
+    key.push_back(o.resting ? 1.0 : 0.0);
+    const Eigen::Matrix4d m = o.X_WA.matrix();
+    key.insert(key.end(), m.data(), m.data() + 12);
+  }
+  for (size_t r = 0; r < state_.held.size(); ++r) {
+    key.push_back(state_.held[r]);
+    if (state_.held[r] >= 0 && r < state_.grasp.size()) {
+      key.push_back(state_.grasp[r].subassembly);
+      key.push_back(state_.grasp[r].index);
+    }
+  }
+  return key;
+}
+
 bool Builder::Tight(int robot, const JointVector& q) {
   // A few small joint perturbations, the same every time.
   std::mt19937_64 g(0x7469676874);
@@ -430,6 +477,18 @@ std::vector<JointVector> Builder::BackOff(int robot, const JointVector& q, doubl
   return {};
 }
 
+bool Builder::MoveOpening(int robot, double wanted) {
+  const double now = opening_[robot];
+  opening_[robot] = wanted;
+  if (wanted == now) return true;
+  if (!SetScene(opening_)) return false;
+  if (!scene_.Collides(std::vector<int>{robot})) return true;
+  opening_[robot] = now;
+  if (!SetScene(opening_)) return false;
+  if (scene_.Collides(std::vector<int>{robot})) opening_[robot] = wanted;
+  return true;
+}
+
 bool Builder::Retreat(int action, int robot) {
   const int node = released_[robot];
   if (node < 0) return true;
@@ -468,8 +527,10 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
   seg.main = main;
   seg.objects = objects;
   seg.openings = opening_;
-  if (const MotionCache::Path& c = cache_.free_paths[index]; !c.waypoints.empty()) {
-    // Reuse a path solved at a lower effort when it is the same query.
+  const std::vector<double> scene_key = SceneKey();
+  if (const MotionCache::Path& c = cache_.free_paths[index];
+      !c.waypoints.empty() && c.scene == scene_key) {
+    // Reuse a path solved at a lower effort when it is the same query in the same scene.
     bool same = true;
     int end = 0;
     for (size_t i = 0; i < movers.size() && same; ++i) {
@@ -555,12 +616,20 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
     const PathAnswer answer = PlanPath(query);
     std::string hit;
     if (std::getenv("WRAP_MOTION_DEBUG") && !answer.solved && !answer.timed_out) {
-      for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], to[i]);
+      const bool at_start = answer.why.find("start") != std::string::npos;
+      for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], at_start ? cur_[who[i]] : to[i]);
       CollisionResult res;
-      if (scene_.cell().InCollision(&res)) {
-        const CollisionWorld& cw = scene_.cell().world();
-        hit = " ('" + cw.body_name(res.first.body_a) + "' hits '" + cw.body_name(res.first.body_b) +
-              "')";
+      if (scene_.cell().InCollision(&res)) hit = " (" + scene_.cell().Describe(res.first) + ")";
+      if (at_start) {
+        for (int r : who) {
+          std::fprintf(stderr, "[free] start of %s: opening %.4f, holds %d; keyframes:", Name(r).c_str(),
+                       opening_[r], state_.held[r]);
+          for (int j = std::max(0, action - 3); j <= action; ++j) {
+            std::fprintf(stderr, " %d:%s", j + 1,
+                         Same(plan_.actions[j].keyframe.q[r], cur_[r]) ? "same" : "differs");
+          }
+          std::fprintf(stderr, "\n");
+        }
       }
     }
     for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], cur_[who[i]]);
@@ -616,7 +685,7 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
   }
   seg.robots = who;
   seg.waypoints = std::move(path);
-  cache_.free_paths[index] = {seg.robots, seg.waypoints};
+  cache_.free_paths[index] = {seg.robots, seg.waypoints, scene_key};
   Push(std::move(seg));
   return true;
 }
@@ -711,34 +780,13 @@ bool Builder::Carry(int action, int node, const std::vector<int>& holders, const
       targets.push_back([&pose, variant, X_AT](double s) { return pose(variant, s) * X_AT; });
     }
     auto path = Track(holders, q0, targets, steps, &goal_q);
-    std::vector<JointVector> goals = goal_q;
     std::vector<std::pair<size_t, JointVector>> rebranch;
     why.clear();
     if (path.empty()) {
       why = "an arm cannot follow the object (no IK solution near the last one)";
       continue;
     }
-    for (size_t i = 0; i < holders.size() && why.empty(); ++i) {
-      const double off = (path.back()[i] - goals[i]).cwiseAbs().maxCoeff();
-      const JointVector same_pose =
-          NearestEquivalent(w_.robots[holders[i]].chain, goals[i], path.back()[i]);
-      if (off > kMaxSnap && (same_pose - path.back()[i]).cwiseAbs().maxCoeff() <= kMaxSnap) {
-        // The keyframe's joints up to turns of 2 pi: the same configuration.
-        rebranch.push_back({i, same_pose});
-        path.back()[i] = same_pose;
-      } else if (off > kMaxSnap) {
-        if (KeyframeAccepts(holders[i], path.back()[i], target, {})) {
-          rebranch.push_back({i, path.back()[i]});
-        } else {
-          why = Name(holders[i]) + " ends " + std::to_string(off).substr(0, 4) +
-                " rad away from its keyframe joints, on another IK solution that does not fit "
-                "the keyframe";
-        }
-      } else {
-        path.back()[i] = goals[i];
-      }
-    }
-    if (!why.empty()) continue;
+    if (!CarryEnd(holders, goal_q, target, path.back(), rebranch, why)) continue;
     if (!SetScene(opening_)) return false;
     if (!PathClear(holders, path)) {
       why = "on the way " + last_hit_;
@@ -749,11 +797,198 @@ bool Builder::Carry(int action, int node, const std::vector<int>& holders, const
               variant == 3 ? dist + 0.2 : std::max(dist, angle * 0.1), opt_.carry_speed_mps);
     return true;
   }
-  return Fail(action, SegmentKind::kCarry, false,
+  // Neither of the straight variants: search the object's poses (at effort 1 and more; at
+  // effort 0 the plan is suspended so that other task plans get their turn first).
+  if (effort_ >= 1 && !ctx_.ShouldStop()) {
+    std::vector<std::pair<size_t, JointVector>> rebranch;
+    double carry_length = 0.0;
+    std::string search_why;
+    if (!SetScene(opening_)) return false;
+    auto path = CarrySearch(holders, X_start, X_goal, goal_q, target, rebranch, &carry_length,
+                            search_why);
+    if (!path.empty()) {
+      for (const auto& [i, q] : rebranch) Rebranch(holders[i], action, approach, goal_q[i], q);
+      PushSkill(SegmentKind::kCarry, action, true, holders, {node}, std::move(path),
+                carry_length, opt_.carry_speed_mps);
+      return true;
+    }
+    why += "; searched over the object's poses: " + search_why;
+  }
+  return Fail(action, SegmentKind::kCarry, !ctx_.ShouldStop(),
               "the robots holding " + NodeName(node) +
                   " cannot carry it together to its keyframe pose (straight, rotating first or "
-                  "last, or over the top): " +
-                  why);
+                  "last, or over the top" +
+                  (effort_ >= 1 ? ", or by a search over its poses" : "") + "): " + why);
+}
+
+bool Builder::CarryEnd(const std::vector<int>& holders, const std::vector<JointVector>& goal_q,
+                       const Keyframe& target, std::vector<JointVector>& last,
+                       std::vector<std::pair<size_t, JointVector>>& rebranch, std::string& why) {
+  for (size_t i = 0; i < holders.size(); ++i) {
+    const double off = (last[i] - goal_q[i]).cwiseAbs().maxCoeff();
+    const JointVector same_pose =
+        NearestEquivalent(w_.robots[holders[i]].chain, goal_q[i], last[i]);
+    if (off > kMaxSnap && (same_pose - last[i]).cwiseAbs().maxCoeff() <= kMaxSnap) {
+      // The keyframe's joints up to turns of 2 pi: the same configuration.
+      rebranch.push_back({i, same_pose});
+      last[i] = same_pose;
+    } else if (off > kMaxSnap) {
+      if (KeyframeAccepts(holders[i], last[i], target, {})) {
+        rebranch.push_back({i, last[i]});
+      } else {
+        why = Name(holders[i]) + " ends " + std::to_string(off).substr(0, 4) +
+              " rad away from its keyframe joints, on another IK solution that does not fit "
+              "the keyframe";
+        return false;
+      }
+    } else {
+      last[i] = goal_q[i];
+    }
+  }
+  return true;
+}
+
+std::vector<std::vector<JointVector>> Builder::CarryEdge(const std::vector<int>& holders,
+                                                         const std::vector<JointVector>& q0,
+                                                         const Iso3& X_a, const Iso3& X_b) {
+  const Eigen::Quaterniond qa(X_a.linear());
+  const Eigen::Quaterniond qb(X_b.linear());
+  const double angle = qa.angularDistance(qb);
+  const double dist = (X_b.translation() - X_a.translation()).norm();
+  const int steps = std::max(
+      2, static_cast<int>(std::ceil(std::max(dist / opt_.cartesian_step_m, 2 * angle / 0.02))));
+  std::vector<std::function<Iso3(double)>> targets;
+  for (int r : holders) {
+    const PlanGrasp& g = state_.grasp[r];
+    const Iso3 X_AT = w_.X_AP[g.part] * g.X_PG;
+    targets.push_back([&, X_AT](double s) {
+      Iso3 X = Iso3::Identity();
+      X.linear() = qa.slerp(s, qb).toRotationMatrix();
+      X.translation() = (1 - s) * X_a.translation() + s * X_b.translation();
+      return X * X_AT;
+    });
+  }
+  auto path = Track(holders, q0, targets, steps, nullptr);
+  if (path.empty() || !PathClear(holders, path)) return {};
+  return path;
+}
+
+std::vector<std::vector<JointVector>> Builder::CarrySearch(
+    const std::vector<int>& holders, const Iso3& X_start, const Iso3& X_goal,
+    const std::vector<JointVector>& goal_q, const Keyframe& target,
+    std::vector<std::pair<size_t, JointVector>>& rebranch, double* length, std::string& why) {
+  struct Node {
+    Iso3 X;
+    std::vector<JointVector> q;
+    int parent = -1;
+  };
+  auto metric = [](const Iso3& a, const Iso3& b) {
+    return (a.translation() - b.translation()).norm() +
+           0.15 * Eigen::Quaterniond(a.linear()).angularDistance(Eigen::Quaterniond(b.linear()));
+  };
+  std::vector<JointVector> q0;
+  for (int r : holders) q0.push_back(cur_[r]);
+  std::vector<Node> tree = {{X_start, q0, -1}};
+  const Vec3 lo = X_start.translation().cwiseMin(X_goal.translation()) - Vec3(0.25, 0.25, 0.05);
+  const Vec3 hi = X_start.translation().cwiseMax(X_goal.translation()) + Vec3(0.25, 0.25, 0.30);
+  const Eigen::Quaterniond qs(X_start.linear());
+  const Eigen::Quaterniond qg(X_goal.linear());
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const double budget_s = opt_.segment_time_s * std::pow(2.0, effort_);  // thread CPU time
+  const double cpu0 = ThreadCpuSeconds();
+  const auto t0 = std::chrono::steady_clock::now();
+  constexpr double kStepM = 0.08;      // longest edge in the metric [m]
+  constexpr int kMaxNodes = 4000;
+  int goal_node = -1;
+  std::vector<JointVector> goal_last;
+  int edges = 0;
+  std::string end_why;
+  while (goal_node < 0 && static_cast<int>(tree.size()) < kMaxNodes && !ctx_.ShouldStop() &&
+         ThreadCpuSeconds() - cpu0 < budget_s) {
+    const bool to_goal = u(rng_) < 0.2;
+    Iso3 X_rand = X_goal;
+    if (!to_goal) {
+      X_rand.translation() = lo + (hi - lo).cwiseProduct(Vec3(u(rng_), u(rng_), u(rng_)));
+      // Orientations between the start's and the goal's, turned by up to ~0.6 rad.
+      const Vec3 axis = Vec3(n01(rng_), n01(rng_), n01(rng_)).normalized();
+      const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.6 * u(rng_), axis));
+      X_rand.linear() = (turn * qs.slerp(u(rng_), qg)).toRotationMatrix();
+    }
+    int nearest = 0;
+    double best = metric(tree[0].X, X_rand);
+    for (size_t k = 1; k < tree.size(); ++k) {
+      const double d = metric(tree[k].X, X_rand);
+      if (d < best) {
+        best = d;
+        nearest = static_cast<int>(k);
+      }
+    }
+    const bool reaches = best <= kStepM;
+    Iso3 X_new = X_rand;
+    if (!reaches) {
+      const double f = kStepM / best;
+      const Iso3& X_n = tree[nearest].X;
+      X_new.translation() = X_n.translation() + f * (X_rand.translation() - X_n.translation());
+      X_new.linear() = Eigen::Quaterniond(X_n.linear())
+                           .slerp(f, Eigen::Quaterniond(X_rand.linear()))
+                           .toRotationMatrix();
+    }
+    ++edges;
+    auto edge = CarryEdge(holders, tree[nearest].q, tree[nearest].X, X_new);
+    if (edge.empty()) continue;
+    tree.push_back({X_new, edge.back(), nearest});
+    if (to_goal && reaches) {
+      std::vector<JointVector> last = edge.back();
+      std::vector<std::pair<size_t, JointVector>> rb;
+      if (CarryEnd(holders, goal_q, target, last, rb, end_why)) {
+        goal_node = static_cast<int>(tree.size()) - 1;
+      }
+    }
+  }
+  if (std::getenv("WRAP_MOTION_DEBUG")) {
+    std::fprintf(stderr, "[carry] search: %zu poses, %d edges tried, %.2f s, %s\n", tree.size(),
+                 edges,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                 goal_node >= 0 ? "reached" : "not reached");
+  }
+  if (goal_node < 0) {
+    why = "the goal pose was not reached from " + std::to_string(tree.size()) + " poses" +
+          (end_why.empty() ? "" : " (" + end_why + ")");
+    return {};
+  }
+  std::vector<int> chain;
+  for (int k = goal_node; k >= 0; k = tree[k].parent) chain.push_back(k);
+  std::reverse(chain.begin(), chain.end());
+  // Shortcut greedily: from each pose, the farthest one along the chain it reaches directly.
+  std::vector<std::vector<JointVector>> path = {q0};
+  double total = 0.0;
+  size_t at = 0;
+  std::vector<JointVector> q = q0;
+  while (at + 1 < chain.size()) {
+    bool moved = false;
+    for (size_t j = chain.size() - 1; j > at && !moved; --j) {
+      auto edge = CarryEdge(holders, q, tree[chain[at]].X, tree[chain[j]].X);
+      if (edge.empty()) continue;
+      if (j + 1 == chain.size()) {
+        std::vector<std::pair<size_t, JointVector>> rb;
+        std::string w;
+        if (!CarryEnd(holders, goal_q, target, edge.back(), rb, w)) continue;
+        rebranch = std::move(rb);
+      }
+      total += metric(tree[chain[at]].X, tree[chain[j]].X);
+      path.insert(path.end(), edge.begin() + 1, edge.end());
+      q = path.back();
+      at = j;
+      moved = true;
+    }
+    if (!moved) {
+      why = "the found path could not be retraced";
+      return {};
+    }
+  }
+  *length = total;
+  return path;
 }
 
 bool Builder::KeyframeAccepts(int robot, const JointVector& q, const Keyframe& kf,
@@ -910,8 +1145,8 @@ bool Builder::Action(int i) {
       cur_[r] = K.q[r];
       // The scene at the keyframe's object poses: the object to grasp where it will be.
       PlanState at = state_;
-      for (const PlanObject& o : K.objects) {
-        if (auto it = at.objects.find(o.node); it != at.objects.end()) it->second.X_WA = o.X_WA;
+      for (const PlanObject& ob : K.objects) {
+        if (auto it = at.objects.find(ob.node); it != at.objects.end()) it->second.X_WA = ob.X_WA;
       }
       std::swap(state_, at);
       std::vector<int> carriers_now;
@@ -1040,12 +1275,17 @@ bool Builder::Action(int i) {
             for (const Alternative& alt : alternatives[k]) others.push_back(alt.approach.front());
           }
           // A grasper opens to its grasp as it moves in (not before: robots moving earlier
-          // pass its fingers as they are).
+          // pass its fingers as they are); where its fingers at that width would hit something
+          // where it stands (open fingers straddling a part), it moves as it is and sets them at
+          // the start of its approach.
+          double grasp_opening = 0.0;
           if (is_grasper) {
-            opening_[free_robots[k]] = GraspOpening(w_.robots[free_robots[k]], new_grasp);
+            grasp_opening = GraspOpening(w_.robots[free_robots[k]], new_grasp);
+            if (!MoveOpening(free_robots[k], grasp_opening)) return false;
           }
           int reached = 0;
           ok = Free(i, true, {free_robots[k]}, {free_goals[k]}, objects, &others, &reached);
+          if (is_grasper) opening_[free_robots[k]] = grasp_opening;
           if (ok && reached > 0) {
             // It reached another IK solution of the grasp: the keyframe follows.
             Alternative& alt = alternatives[k][reached - 1];
@@ -1066,7 +1306,9 @@ bool Builder::Action(int i) {
       out_.resize(saved_out);
       cur_ = saved_cur;
       opening_ = saved_opening;
-      for (int r : graspers) opening_[r] = GraspOpening(w_.robots[r], new_grasp);
+      for (int r : graspers) {
+        if (!MoveOpening(r, GraspOpening(w_.robots[r], new_grasp))) return false;
+      }
       free_index_ = saved_index + n_orders * static_cast<int>(free_robots.size());
       std::vector<size_t> order(free_robots.size());
       for (size_t k = 0; k < order.size(); ++k) order[k] = k;
@@ -1079,6 +1321,7 @@ bool Builder::Action(int i) {
         goals.push_back(free_goals[k]);
       }
       ok = Free(i, true, robots, goals, free_objects);
+      for (int r : graspers) opening_[r] = GraspOpening(w_.robots[r], new_grasp);
     }
     if (!ok) return false;
   }

@@ -30,7 +30,8 @@ struct MotionOptions {
   /// checked states differ by at most this in every joint [rad]; skills and final paths are
   /// checked 4 times finer. (The trajectory check samples at 0.02 rad.)
   double resolution_rad = 0.01;
-  double segment_time_s = 0.5;      ///< RRT-Connect budget per free segment at effort 0 [s].
+  double segment_time_s = 0.5;      ///< Search budget per free segment or carry at effort 0
+                                    ///< (thread CPU time) [s].
   int max_effort = 3;               ///< Effort levels 0..max_effort; the budget doubles per level.
   double approach_m = 0.04;         ///< Straight approach to (and retreat from) a grasp [m].
   double lift_m = 0.02;             ///< Straight lift off (and descent onto) the table [m].
@@ -78,6 +79,9 @@ struct MotionCache {
   struct Path {
     std::vector<int> robots;                          ///< Robots of the composite space.
     std::vector<std::vector<JointVector>> waypoints;  ///< Empty where not solved.
+    /// The scene the path was solved in (every robot's joints, the objects, the holds and the
+    /// finger openings): a path is reused only in the very same scene.
+    std::vector<double> scene;
   };
   std::vector<Path> free_paths;  ///< By free segment index.
 };

@@ -1,5 +1,6 @@
 #include "pipeline/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -69,9 +70,16 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
 
   while (!ctx.ShouldStop()) {
     // NextTaskPlan: another task plan once every queued plan has been suspended at least once.
+    // New plans and more effort take turns: while the least effort in the queue is e, up to
+    // 4 + 4 e task plans are made before the suspended ones get more effort.
     bool all_suspended = !queue.empty();
-    for (const Candidate& c : queue) all_suspended = all_suspended && c.effort > 0;
-    if ((queue.empty() || all_suspended) && made < options.max_task_plans) {
+    int least_effort = options.motion.max_effort;
+    for (const Candidate& c : queue) {
+      all_suspended = all_suspended && c.effort > 0;
+      least_effort = std::min(least_effort, c.effort);
+    }
+    const bool room = made < std::min(options.max_task_plans, 4 + 4 * least_effort);
+    if ((queue.empty() || (all_suspended && room)) && made < options.max_task_plans) {
       TaskPlannerOptions task = options.task;
       task.optimize = false;
       RunContext sub(seed + 7919ULL * static_cast<std::uint64_t>(made));

@@ -26,7 +26,7 @@ struct PipelineOptions {
   KeyframeOptOptions keyframes;    ///< Joint keyframe optimisation's.
   bool task_only = false;          ///< Stop after the task plan (no keyframe optimisation, motion).
   bool optimize_keyframes = true;  ///< Run the joint keyframe optimisation before motion.
-  int max_task_plans = 8;  ///< Task plans the loop may ask for (the first with ctx's generator).
+  int max_task_plans = 32;  ///< Task plans the loop may ask for (the first with ctx's generator).
   /// The run's seed (ctx's): recorded in the stats; further task plans and the motion planner's
   /// sampling derive their seeds from it.
   std::uint64_t seed = 0;
