@@ -9,7 +9,7 @@
 #                               into build-asan and run the whole test suite there
 #   scripts/dev.sh sanitize-ci  the part of `sanitize` that CI runs: no UI, only the suites in
 #                               SANITIZE_CI_SUITES below (core, model, geometry, robot,
-#                               collision, wrench, the fuzz regression and seed replay)
+#                               collision with URDF import, the fuzz regression and seed replay)
 # BUILD_DIR (default: build), SANITIZE_BUILD_DIR (default: build-asan) and BUILD_TYPE (default:
 # RelWithDebInfo) may be set.
 set -euo pipefail
@@ -19,12 +19,12 @@ mode=${1:-demo}
 BUILD_TYPE=${BUILD_TYPE:-RelWithDebInfo}
 
 # The suites (test binaries, ctest labels) of `sanitize-ci`: the loaders (project JSON, meshes,
-# URDF: model, geometry, robot, and the fuzz corpus replay) and the engine below the planner, which
-# build without the planner, motion, sim or UI libraries. The other suites (task, motion, sim,
-# app and reliability, render, GUI) run under sanitizers only in `sanitize`: building the whole
-# engine with ASan does not fit CI's time budget next to the normal build.
+# URDF: model, geometry, robot and collision with the URDF importer, and the fuzz corpus replay),
+# which build without the wrench, planner, motion, sim or UI libraries. The other suites (wrench,
+# task, motion, sim, app and reliability, render, GUI) run under sanitizers only in `sanitize`:
+# building the whole engine with ASan does not fit CI's time budget next to the normal build.
 SANITIZE_CI_SUITES=(core_test model_test geometry_test robot_test robot_no_alloc_test
-  collision_test wrench_test fuzz_replay_test)
+  collision_test fuzz_replay_test)
 
 bash scripts/install_deps.sh
 case "$mode" in
