@@ -1,4 +1,5 @@
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -7,6 +8,8 @@
 #include "core/file_io.h"
 #include "core/run_context.h"
 #include "load.h"
+#include "sim/scene.h"
+#include "sim_video.h"
 #include "task/plan_json.h"
 #include "verify/simulate.h"
 
@@ -29,11 +32,17 @@ std::string Percent(double u) {
 }  // namespace
 
 int Sim(const SimArgs& args, std::ostream& out, std::ostream& err) {
+  // A video that cannot be made is said before anything runs.
   if (!args.video.empty()) {
-    return Report({ErrorCode::kInvalidInput,
-                   "--video is not implemented yet (simulate without it, or render the plan with "
-                   "'wrap render --plan ... --video')"},
-                  err);
+    if (auto ok = CheckSimVideo(); !ok) return Report(ok.error(), err);
+    const std::filesystem::path parent = std::filesystem::absolute(args.video).parent_path();
+    std::error_code ec;
+    if (!std::filesystem::is_directory(parent, ec)) {
+      return Report({ErrorCode::kInvalidInput,
+                     "--video " + args.video + ": the folder " + parent.string() +
+                         " does not exist"},
+                    err);
+    }
   }
   // The plan's own structure first: it is cheap and names the field at fault.
   auto plan = ReadPlanFile(args.plan);
@@ -50,6 +59,13 @@ int Sim(const SimArgs& args, std::ostream& out, std::ostream& err) {
   SimOptions options;
   options.force_scale = args.force_scale;
   options.mjcf_dir = args.mjcf_dir;
+  std::vector<SimFrame> frames;
+  if (!args.video.empty()) {
+    options.frame_interval_s = 0.1;
+    options.on_frame = [&frames](double t, const SceneState& state) {
+      frames.push_back({t, state, 0.1});
+    };
+  }
   RunContext ctx;
   auto report = SimulatePlan(*loaded.project, loaded.check, args.project, *plan, options, ctx);
   if (!report) {
@@ -78,7 +94,14 @@ int Sim(const SimArgs& args, std::ostream& out, std::ostream& err) {
     }
     out << ": " << f.reason << " at t = " << Fmt("%.3f", f.t_s) << " s: " << f.detail << "\n";
   }
+  for (const std::string& n : report->notes) out << "note: " << n << "\n";
   if (!args.output.empty()) out << "wrote " << args.output << "\n";
+  if (!args.video.empty()) {
+    auto scene = BuildCellScene(*loaded.project, loaded.check, args.project);
+    if (!scene) return Report(scene.error(), err);
+    if (auto ok = WriteSimVideo(*scene, frames, args.video); !ok) return Report(ok.error(), err);
+    out << "wrote " << args.video << " (" << frames.size() << " frames)\n";
+  }
   return report->success ? 0 : 1;
 }
 

@@ -53,6 +53,10 @@ std::string SerializeSimReport(const SimReport& report) {
   j["simulated_s"] = report.simulated_s;
   j["steps"] = report.steps;
   j["robots_driven"] = report.driving;
+  j["motion"] = report.motion;
+  j["collisions_judged"] = report.collisions_judged;
+  j["collision_checks"] = report.collision_checks;
+  j["notes"] = report.notes;
   j["warnings"] = report.warnings;
   return j.dump(2) + "\n";
 }

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <memory>
@@ -12,12 +14,15 @@
 #include "sim/mjcf.h"
 #include "sim/mujoco_model.h"
 #include "sim/scene.h"
+#include "verify/detail/collisions.h"
+#include "verify/detail/keyframe_replay.h"
 
 namespace wrap {
 
 namespace {
 
 constexpr int kWeldRows = 6;  // a weld constrains 3 positions and 3 rotations
+constexpr double kReleaseGrace_s = 0.5;  // a released object may touch its gripper this long
 
 double AngleOf(const Mat3& R) { return std::abs(Eigen::AngleAxisd(R).angle()); }
 
@@ -123,8 +128,14 @@ struct DataDeleter {
 class Simulator {
  public:
   Simulator(const Project& project, const CellScene& scene, const AssemblyTree& tree,
-            const Plan& plan, const SimOptions& options, RunContext& ctx)
-      : project_(project), scene_(scene), tree_(tree), plan_(plan), options_(options), ctx_(ctx) {}
+            const Plan& plan, bool keyframes, const SimOptions& options, RunContext& ctx)
+      : project_(project),
+        scene_(scene),
+        tree_(tree),
+        plan_(plan),
+        keyframes_(keyframes),
+        options_(options),
+        ctx_(ctx) {}
 
   Result<SimReport> Run() {
     if (auto ok = Setup(); !ok) return std::unexpected(ok.error());
@@ -228,6 +239,14 @@ class Simulator {
       makespan_ = std::max(makespan_, tr.knots.back().t);
     }
     for (const PlanAction& a : plan_.actions) makespan_ = std::max(makespan_, a.end_s);
+    report_.motion = keyframes_ ? "keyframes" : "trajectories";
+    report_.collisions_judged = options_.check_collisions && !keyframes_;
+    if (report_.collisions_judged) {
+      auto judge = detail::SimCollisions::Build(scene_, options_.collision_tolerance_m);
+      if (!judge) return std::unexpected(judge.error());
+      collisions_.emplace(std::move(*judge));
+      ContactWindows();
+    }
     SetTcps(0.0);
     mj_forward(model_.get(), data_.get());
     return {};
@@ -246,8 +265,23 @@ class Simulator {
   }
 
   void SetTcps(double t) {
+    std::vector<Iso3> X_WT(tcp_mocap_.size());
+    for (size_t r = 0; r < tcp_mocap_.size(); ++r) X_WT[r] = Tcp(static_cast<int>(r), t);
+    if (keyframes_) {
+      // Keyframes are joined straight in joint space, which would pull apart the grippers of a
+      // shared object: its other holders follow the first one's TCP at their grasps.
+      for (const auto& [node, o] : objects_) {
+        if (o.holders.size() < 2) continue;
+        const int c = o.holders.front();
+        const Iso3 X_WA = X_WT[c] * (scene_.parts[grasp_[c].part].X_AP * grasp_[c].X_PG).inverse();
+        for (size_t k = 1; k < o.holders.size(); ++k) {
+          const PlanGrasp& g = grasp_[o.holders[k]];
+          X_WT[o.holders[k]] = X_WA * scene_.parts[g.part].X_AP * g.X_PG;
+        }
+      }
+    }
     for (size_t r = 0; r < tcp_mocap_.size(); ++r) {
-      const Iso3 X = Tcp(static_cast<int>(r), t);
+      const Iso3& X = X_WT[r];
       const int i = tcp_mocap_[r];
       Eigen::Quaterniond q(X.linear());
       q.normalize();
@@ -319,12 +353,192 @@ class Simulator {
 
   void Failed(int action, const std::string& reason, const std::string& detail, double t) {
     if (report_.failure) return;
+    if (std::getenv("WRAP_SIM_DEBUG")) {
+      for (int c = 0; c < data_->ncon; ++c) {
+        const mjContact& con = data_->contact[c];
+        const char* n1 = mj_id2name(model_.get(), mjOBJ_BODY, model_->geom_bodyid[con.geom1]);
+        const char* n2 = mj_id2name(model_.get(), mjOBJ_BODY, model_->geom_bodyid[con.geom2]);
+        std::fprintf(stderr, "[contact] %s - %s dist %.4f\n", n1 ? n1 : "world", n2 ? n2 : "world",
+                     con.dist);
+      }
+    }
     report_.failure = SimFailure{action, reason, detail, t};
     if (action >= 0) report_.actions[action].status = "failed";
   }
 
+  // Where a robot may touch an object besides holding it (plan segments): from the start of its
+  // approach through the grip to the grasp, while its gripper closes or opens, during its
+  // retreat, and the robots of an insertion with both inputs (which may touch each other then).
+  void ContactWindows() {
+    for (const MotionSegment& s : plan_.segments) {
+      if (s.action < 0 || s.action >= static_cast<int>(plan_.actions.size())) continue;
+      const double end_s = plan_.actions[s.action].end_s;
+      if (s.kind == "approach") {
+        windows_.push_back({s.start_s, std::max(s.end_s, end_s), s.robots, s.objects, false});
+      } else if (s.kind == "grip" || s.kind == "retreat") {
+        windows_.push_back({s.start_s, s.end_s, s.robots, s.objects, false});
+      } else if (s.kind == "insert" && s.objects.size() >= 2) {
+        windows_.push_back({s.start_s, std::max(s.end_s, end_s), plan_.actions[s.action].robots,
+                            {s.objects[0], s.objects[1]}, true});
+      }
+    }
+  }
+
+  // The contacts allowed at t: a robot with what it holds, parts of one object, parts nobody
+  // holds with each other (they do not collide in MuJoCo either), and the windows open at t.
+  detail::ContactRules Rules(double t) const {
+    const int nr = static_cast<int>(scene_.robots.size());
+    const int np = static_cast<int>(scene_.parts.size());
+    detail::ContactRules rules;
+    std::vector<int> node_of(np, -1);
+    rules.held.assign(np, 0);
+    rules.robot_part_ok.assign(nr, std::vector<char>(np, 0));
+    rules.part_pair_ok.assign(np, std::vector<char>(np, 0));
+    for (const auto& [node, o] : objects_) {
+      for (int p : tree_.nodes[node].parts) {
+        node_of[p] = node;
+        rules.held[p] = !o.holders.empty();
+        for (int r : o.holders) rules.robot_part_ok[r][p] = 1;
+      }
+    }
+    // A part nobody holds that is moving fast is falling or sliding: its fate is judged as
+    // support ("no support"), not by what it hits on the way.
+    std::vector<char> loose(np, 0);
+    for (int p = 0; p < np; ++p) {
+      const mjtNum* v = data_->qvel + part_dof_[p];
+      loose[p] = !rules.held[p] && std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) > 0.05;
+      if (loose[p]) {
+        for (int r = 0; r < nr; ++r) rules.robot_part_ok[r][p] = 1;
+      }
+    }
+    for (int p = 0; p < np; ++p) {
+      for (int q = p + 1; q < np; ++q) {
+        rules.part_pair_ok[p][q] = node_of[p] == node_of[q] ||
+                                   (!rules.held[p] && !rules.held[q]) || loose[p] || loose[q];
+      }
+    }
+    const double slack = 2.0 * options_.sample_every * model_->opt.timestep;
+    for (const Window& w : windows_) {
+      if (t < w.t0 - slack || t > w.t1 + slack) continue;
+      for (int node : w.nodes) {
+        for (int p : tree_.nodes[node].parts) {
+          for (int r : w.robots) rules.robot_part_ok[r][p] = 1;
+        }
+      }
+      if (w.pair && w.nodes.size() >= 2) {
+        for (int p : tree_.nodes[w.nodes[0]].parts) {
+          for (int q : tree_.nodes[w.nodes[1]].parts) {
+            rules.part_pair_ok[std::min(p, q)][std::max(p, q)] = 1;
+          }
+        }
+      }
+    }
+    return rules;
+  }
+
+  // The action a robot was working on at t: that of its motion segment under way (or just
+  // ended: checks come every few steps), else the action under way.
+  int ActionOfRobot(int r, double t) const {
+    const double slack = 2.0 * options_.sample_every * model_->opt.timestep;
+    for (const MotionSegment& s : plan_.segments) {
+      if (s.action >= 0 && s.start_s <= t && t <= s.end_s + slack &&
+          std::find(s.robots.begin(), s.robots.end(), r) != s.robots.end()) {
+        return s.action;
+      }
+    }
+    return CurrentAction();
+  }
+
+  // The robots where they are driven and the parts where MuJoCo has them.
+  SceneState CurrentState(double t) const {
+    SceneState state;
+    for (size_t r = 0; r < scene_.robots.size(); ++r) {
+      const RobotTrajectory& tr = plan_.trajectories[r];
+      state.q.push_back(SampleTrajectory(tr, t));
+      const double o = OpeningAt(tr, t);
+      const double stroke = scene_.robots[r].end_effector.stroke_m;
+      state.opening_m.push_back(o < 0.0 ? stroke : std::clamp(o, 0.0, stroke));
+    }
+    for (size_t p = 0; p < scene_.parts.size(); ++p) {
+      state.X_WP.push_back(PartPose(static_cast<int>(p)));
+    }
+    return state;
+  }
+
+  // Collisions at t, when something moved enough since the last check (or an action happened).
+  Result<void> CheckCollisions(double t) {
+    if (!collisions_) return {};
+    const int nr = static_cast<int>(scene_.robots.size());
+    const int np = static_cast<int>(scene_.parts.size());
+    std::vector<JointVector> q(nr);
+    std::vector<double> openings(nr);
+    for (int r = 0; r < nr; ++r) {
+      q[r] = SampleTrajectory(plan_.trajectories[r], t);
+      openings[r] = OpeningAt(plan_.trajectories[r], t);
+    }
+    std::vector<Iso3> X_WP(np);
+    for (int p = 0; p < np; ++p) X_WP[p] = PartPose(p);
+    bool moved = collision_dirty_ || checked_q_.empty();
+    for (int r = 0; r < nr && !moved; ++r) {
+      moved = (q[r] - checked_q_[r]).cwiseAbs().maxCoeff() > options_.collision_resolution_rad ||
+              openings[r] != checked_openings_[r];
+    }
+    for (int p = 0; p < np && !moved; ++p) {
+      moved = (X_WP[p].translation() - checked_X_WP_[p].translation()).norm() >
+                  options_.collision_resolution_m ||
+              AngleOf(X_WP[p].linear().transpose() * checked_X_WP_[p].linear()) >
+                  options_.collision_resolution_rad;
+    }
+    if (!moved) return {};
+    checked_q_ = q;
+    checked_openings_ = openings;
+    checked_X_WP_ = X_WP;
+    collision_dirty_ = false;
+    ++report_.collision_checks;
+    auto hit = collisions_->Check(q, openings, X_WP, Rules(t));
+    if (!hit) return std::unexpected(hit.error());
+    if (!hit->has_value()) return {};
+    const detail::CollisionHit& h = **hit;
+    auto holder = [&](int p) {
+      for (const auto& [node, o] : objects_) {
+        const auto& parts = tree_.nodes[node].parts;
+        if (!o.holders.empty() && std::find(parts.begin(), parts.end(), p) != parts.end()) {
+          return o.holders.front();
+        }
+      }
+      return -1;
+    };
+    auto part_words = [&](int p, const std::string& name) {
+      const int r = holder(p);
+      return "'" + name + "'" + (r >= 0 ? " (held by '" + scene_.robots[r].name + "')" : "");
+    };
+    int robot = h.robot_a >= 0 ? h.robot_a : h.robot_b;
+    if (robot < 0 && h.part_a >= 0) robot = holder(h.part_a);
+    if (robot < 0 && h.part_b >= 0) robot = holder(h.part_b);
+    const std::string tol = Num(1000 * options_.collision_tolerance_m) + " mm";
+    std::string detail;
+    if (h.body_b == "table" && h.part_a >= 0) {
+      detail = part_words(h.part_a, h.body_a) + " is " + Num(1000 * h.depth_m) +
+               " mm into the table (tolerance " + tol + ")";
+    } else {
+      const std::string a =
+          h.part_a >= 0 ? part_words(h.part_a, h.body_a) : "'" + h.body_a + "'";
+      const std::string b =
+          h.part_b >= 0 ? part_words(h.part_b, h.body_b) : "'" + h.body_b + "'";
+      detail = a + " touches " + b + " deeper than the " + tol + " tolerance";
+      if (h.robot_a >= 0 && h.robot_b >= 0) {
+        detail += " (robot against robot)";
+      } else if ((h.robot_a >= 0) != (h.robot_b >= 0) && (h.part_a >= 0 || h.part_b >= 0)) {
+        detail += " (a part the robot neither holds nor is grasping or releasing)";
+      }
+    }
+    Failed(robot >= 0 ? ActionOfRobot(robot, t) : CurrentAction(), "collision", detail, t);
+    return {};
+  }
+
   // The moment of action i: grips close or open, connections are made.
   void Event(int i, double t) {
+    collision_dirty_ = true;
     const PlanAction& a = plan_.actions[i];
     const int node = a.objects.empty() ? -1 : a.objects[0];
     auto take = [&](int r, const PlanGrasp& g) {
@@ -334,6 +548,8 @@ class Simulator {
       Grip(r, g);
     };
     auto drop = [&](int r) {
+      // The gripper that lets go may touch the object a little longer (it falls or is left).
+      windows_.push_back({t, t + kReleaseGrace_s, {r}, {node}, false});
       Object& o = objects_[node];
       if (o.holders.size() == 1 && o.holders.front() == r) o.X_WA = ExpectedX_WA(o);
       o.holders.erase(std::remove(o.holders.begin(), o.holders.end(), r), o.holders.end());
@@ -605,8 +821,14 @@ class Simulator {
     const double t_end = makespan_ + std::max(0.0, options_.settle_s);
     const long long n_steps = static_cast<long long>(std::ceil(t_end / dt));
     const int every = std::max(1, options_.sample_every);
+    const double frame_dt = options_.frame_interval_s > 0.0 ? options_.frame_interval_s : 0.1;
+    double next_frame_s = 0.0;
     for (long long k = 0; k < n_steps; ++k) {
       const double t = k * dt;
+      if (options_.on_frame && t >= next_frame_s - 1e-9) {
+        options_.on_frame(t, CurrentState(t));
+        next_frame_s += frame_dt;
+      }
       while (next_event_ < order_.size() && plan_.actions[order_[next_event_]].end_s <= t) {
         Event(order_[next_event_++], t);
         if (report_.failure) break;
@@ -622,12 +844,15 @@ class Simulator {
       if (k % every == 0) {
         Measure(t, inserting);
         if (report_.failure) break;
+        if (auto ok = CheckCollisions(t); !ok) return ok;
+        if (report_.failure) break;
       }
       if (k % 1000 == 0 && ctx_.ShouldStop()) {
         return wrap::Fail(ErrorCode::kCancelled, "sim: stopped at t = " + Num(t) + " s");
       }
     }
     if (!report_.failure) CheckFinal(report_.simulated_s);
+    if (options_.on_frame) options_.on_frame(report_.simulated_s, CurrentState(report_.simulated_s));
     return {};
   }
 
@@ -635,9 +860,22 @@ class Simulator {
   const CellScene& scene_;
   const AssemblyTree& tree_;
   const Plan& plan_;
+  const bool keyframes_;  // a keyframe replay (no motion in the plan)
   const SimOptions& options_;
   RunContext& ctx_;
   SimReport report_;
+  struct Window {
+    double t0 = 0.0, t1 = 0.0;
+    std::vector<int> robots;
+    std::vector<int> nodes;
+    bool pair = false;  // the two nodes may touch each other too (an insertion)
+  };
+  std::vector<Window> windows_;                       // contact windows, from the segments
+  std::optional<detail::SimCollisions> collisions_;   // when collisions are judged
+  bool collision_dirty_ = true;                       // an action happened since the last check
+  std::vector<JointVector> checked_q_;                // at the last collision check
+  std::vector<double> checked_openings_;
+  std::vector<Iso3> checked_X_WP_;
 
   std::unique_ptr<mjModel, ModelDeleter> model_;
   std::unique_ptr<mjData, DataDeleter> data_;
@@ -680,13 +918,32 @@ Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check
   auto scene = BuildCellScene(project, check, project_file);
   if (!scene) return std::unexpected(scene.error());
   const AssemblyTree& tree = *check.tree;
-  if (plan.trajectories.size() != scene->robots.size()) {
-    return bad("trajectories: the plan has none for the cell's " +
-               std::to_string(scene->robots.size()) +
-               " robots (plan it with motion: 'wrap plan' without --task-only)");
+  if (!(options.frame_interval_s > 0.0) || !std::isfinite(options.frame_interval_s)) {
+    return bad("sim: the frame interval must be a positive number of seconds");
+  }
+  // A plan without motion: its keyframes replayed one action at a time.
+  std::optional<Plan> timed;
+  std::vector<std::string> notes;
+  if (plan.trajectories.empty()) {
+    timed = plan;
+    if (auto ok = detail::TimeKeyframes(*scene, tree, *timed, {}, notes); !ok) {
+      return std::unexpected(ok.error());
+    }
+  }
+  const Plan& run = timed ? *timed : plan;
+  if (timed && std::getenv("WRAP_SIM_DEBUG")) {
+    for (const MotionSegment& m : run.segments) {
+      std::fprintf(stderr, "[replay] %s action %d robots %zu: %.3f - %.3f s\n", m.kind.c_str(),
+                   m.action, m.robots.size(), m.start_s, m.end_s);
+    }
+  }
+  if (run.trajectories.size() != scene->robots.size()) {
+    return bad("trajectories: " + std::to_string(run.trajectories.size()) +
+               " trajectories for the cell's " + std::to_string(scene->robots.size()) +
+               " robots (one per robot, or none for a keyframe replay)");
   }
   for (size_t r = 0; r < scene->robots.size(); ++r) {
-    const RobotTrajectory& tr = plan.trajectories[r];
+    const RobotTrajectory& tr = run.trajectories[r];
     if (tr.knots.empty() || tr.knots.front().q.size() != scene->robots[r].chain.dof()) {
       return bad("trajectories[" + std::to_string(r) + "]: the trajectory of robot '" +
                  scene->robots[r].name + "' does not fit its " +
@@ -694,8 +951,8 @@ Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check
     }
   }
   const int n_nodes = static_cast<int>(tree.nodes.size());
-  for (size_t i = 0; i < plan.actions.size(); ++i) {
-    const PlanAction& a = plan.actions[i];
+  for (size_t i = 0; i < run.actions.size(); ++i) {
+    const PlanAction& a = run.actions[i];
     const std::string where = "actions[" + std::to_string(i) + "]: ";
     if (!(a.end_s >= 0.0)) return bad(where + "no timing (end_s); the plan has no motion");
     const size_t n_robots = a.type == ActionType::kHandover ? 2 : 1;
@@ -715,15 +972,24 @@ Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check
     }
   }
   std::vector<int> seen(scene->parts.size(), 0);
-  for (const PlanObject& o : plan.initial.objects) {
+  for (const PlanObject& o : run.initial.objects) {
     if (o.node < 0 || o.node >= n_nodes) return bad("initial: object is not a node");
     for (int p : tree.nodes[o.node].parts) ++seen[p];
   }
   for (size_t p = 0; p < seen.size(); ++p) {
     if (seen[p] != 1) return bad("initial: part '" + scene->parts[p].name + "' is not placed once");
   }
-  Simulator sim(project, *scene, tree, plan, options, ctx);
-  return sim.Run();
+  Simulator sim(project, *scene, tree, run, timed.has_value(), options, ctx);
+  auto report = sim.Run();
+  if (report) {
+    for (std::string& n : notes) report->notes.push_back(std::move(n));
+    if (timed) {
+      report->notes.insert(report->notes.begin(),
+                           "the plan has no motion: its keyframes were replayed one action at a "
+                           "time, straight in joint space (collisions not judged)");
+    }
+  }
+  return report;
 }
 
 }  // namespace wrap

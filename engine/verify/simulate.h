@@ -10,6 +10,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "core/run_context.h"
 #include "model/project.h"
 #include "model/validate.h"
+#include "sim/scene.h"
 #include "task/plan.h"
 
 namespace wrap {
@@ -36,6 +38,23 @@ struct SimOptions {
   double zero_limit_force_N = 1.0;
   double zero_limit_torque_Nm = 0.05;  ///< Same for torques [N m].
   int sample_every = 5;                ///< Measure wrenches and drift every this many steps.
+  /// Judge collisions (robots with robots, robots with parts they neither hold nor are grasping
+  /// or releasing, held parts with anything but their mating partner during its insertion, a
+  /// held part into the table). Only with trajectories: a keyframe replay is not collision-free
+  /// by construction, so its collisions are never judged.
+  bool check_collisions = true;
+  /// Contacts no deeper than this do not count [m]: every robot shape is shrunk by it (two robots
+  /// may overlap by twice it), a held part may sink this far into the table.
+  double collision_tolerance_m = 0.002;
+  /// Collisions are checked after a joint moved this much since the last check [rad] ...
+  double collision_resolution_rad = 0.01;
+  /// ... or a part this much [m], or an action happened.
+  double collision_resolution_m = 0.002;
+  /// Called with the simulated cell every `frame_interval_s` of simulated time (from t = 0 and
+  /// once more at the end) when set, e.g. to record a video: robots at their driven joints,
+  /// parts where MuJoCo has them. Never called with GL: drawing is the caller's business.
+  std::function<void(double t_s, const SceneState& state)> on_frame;
+  double frame_interval_s = 0.1;  ///< [s] > 0.
   /// When set, the physics model is also written here (cell.xml and meshes, sim/mjcf.h
   /// WriteMjcf), e.g. to open it in MuJoCo's `simulate`.
   std::filesystem::path mjcf_dir;
@@ -68,7 +87,8 @@ struct SimActionStatus {
 /// Why a plan failed in simulation.
 struct SimFailure {
   int action = -1;     ///< Index of the action blamed.
-  std::string reason;  ///< "no support", "slip", "vacuum limit", "misalignment".
+  /// "no support", "slip", "vacuum limit", "collision", "misalignment".
+  std::string reason;
   std::string detail;  ///< In words: which part or robot, the numbers seen.
   double t_s = 0.0;    ///< Simulated time it was detected [s].
 };
@@ -86,15 +106,25 @@ struct SimReport {
   double simulated_s = 0.0;              ///< Simulated time [s].
   long long steps = 0;                   ///< Integration steps.
   std::string driving = "kinematic TCP mocap";  ///< How the robots are driven.
+  /// "trajectories" (the plan's timed motion) or "keyframes" (a plan without motion: its
+  /// keyframes replayed one action at a time, straight in joint space; see `notes`).
+  std::string motion = "trajectories";
+  bool collisions_judged = false;  ///< Collisions were checked during the run.
+  long long collision_checks = 0;  ///< Moments checked for collisions.
+  std::vector<std::string> notes;  ///< What the run approximated (keyframe replay).
   std::vector<std::string> warnings;            ///< MuJoCo warnings, approximated meshes.
 };
 
-/// Simulates `plan` (with trajectories) of `project` (validated: `check` holds its meshes and
-/// tree; `project_file` resolves URDFs). Fails with kInvalidInput when the plan has no motion or
-/// does not fit the cell (the message starts with the plan's JSON path, e.g. "trajectories: ..."
-/// or "actions[3]: ..."; callers prefix the plan file), kInternal with MuJoCo's message when MuJoCo
-/// raises an error (never exits), kCancelled when `ctx` stops. A plan that fails in simulation is a
-/// SimReport with success false, not an error.
+/// Simulates `plan` of `project` (validated: `check` holds its meshes and tree; `project_file`
+/// resolves URDFs). A plan with trajectories runs them; a plan without (`wrap plan --task-only`)
+/// replays its keyframes (report.motion "keyframes": one action at a time, robots straight in
+/// joint space between keyframes within their velocity and acceleration limits, a lift after a
+/// pick, a descent before a place, the insertion from the approach keyframe; robots that share an
+/// object follow the first holder's TCP; collisions are not judged). Fails with kInvalidInput when
+/// the plan does not fit the cell (the message starts with the plan's JSON path, e.g.
+/// "trajectories: ..." or "actions[3]: ..."; callers prefix the plan file), kInternal with MuJoCo's
+/// message when MuJoCo raises an error (never exits), kCancelled when `ctx` stops. A plan that
+/// fails in simulation is a SimReport with success false, not an error.
 Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check,
                                const std::filesystem::path& project_file, const Plan& plan,
                                const SimOptions& options, RunContext& ctx);

@@ -4,10 +4,14 @@
 #include <algorithm>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 
 #include "../task/planning_fixture.h"
 #include "pipeline/pipeline.h"
+#include "robot/ik.h"
+#include "robot/kinematics.h"
+#include "sim/scene.h"
 #include "sim/mujoco_model.h"
 #include "verify/simulate.h"
 
@@ -54,28 +58,65 @@ const Planned& PlanOnce(const std::string& name) {
   return p;
 }
 
-Result<SimReport> Simulate(const Planned& p, const Plan& plan, const SimOptions& options = {}) {
-  RunContext ctx(0);
-  return SimulatePlan(*p.lp.project, p.lp.check, p.file, plan, options, ctx);
-}
-
-// The first pick of the plan, its index.
-int FirstPick(const Plan& plan) {
-  for (size_t i = 0; i < plan.actions.size(); ++i) {
-    if (plan.actions[i].type == ActionType::kPick) return static_cast<int>(i);
+// The tests' common set-up: an example project's plan (planned once per binary), simulations of
+// it or of a changed copy, and the actions they look for.
+class Sim : public ::testing::Test {
+ protected:
+  // Plans `name` (once) and keeps it as the test's project; false (with a failure) when it has
+  // no plan with motion.
+  bool Use(const std::string& name) {
+    p_ = &PlanOnce(name);
+    EXPECT_TRUE(p_->error.empty()) << p_->error;
+    return p_->error.empty();
   }
-  return -1;
-}
+  const Plan& plan() const { return *p_->plan; }
+  const Project& project() const { return *p_->lp.project; }
+  const AssemblyTree& tree() const { return *p_->lp.check.tree; }
 
-TEST(Sim, FullModelPlanHolds) {
-  const Planned& p = PlanOnce("half_stool");
-  ASSERT_TRUE(p.error.empty()) << p.error;
-  auto report = Simulate(p, *p.plan);
+  // Simulates `plan` of the project (or of `changed`, the project edited after planning).
+  Result<SimReport> Simulate(const Plan& plan, const SimOptions& options = {},
+                             const Project* changed = nullptr) const {
+    RunContext ctx(0);
+    return SimulatePlan(changed ? *changed : project(), p_->lp.check, p_->file, plan, options,
+                        ctx);
+  }
+
+  // The first action of `type` in plan order, or -1.
+  static int First(const Plan& plan, ActionType type) {
+    for (size_t i = 0; i < plan.actions.size(); ++i) {
+      if (plan.actions[i].type == type) return static_cast<int>(i);
+    }
+    return -1;
+  }
+
+  // The assemble that happens first in time, or -1.
+  static int FirstAssembleInTime(const Plan& plan) {
+    int assemble = -1;
+    for (size_t i = 0; i < plan.actions.size(); ++i) {
+      const PlanAction& a = plan.actions[i];
+      if (a.type != ActionType::kAssemble) continue;
+      if (assemble < 0 || a.end_s < plan.actions[assemble].end_s) assemble = static_cast<int>(i);
+    }
+    return assemble;
+  }
+
+  // "reason at action i: detail" of a report that failed, "holds" otherwise.
+  static std::string Verdict(const SimReport& r) {
+    if (!r.failure) return "holds";
+    return r.failure->reason + " at action " + std::to_string(r.failure->action) + ": " +
+           r.failure->detail;
+  }
+
+  const Planned* p_ = nullptr;
+};
+
+TEST_F(Sim, FullModelPlanHolds) {
+  if (!Use("half_stool")) return;
+  auto report = Simulate(plan());
   ASSERT_TRUE(report) << report.error().message;
-  EXPECT_TRUE(report->success) << report->failure->reason << " at action "
-                               << report->failure->action << ": " << report->failure->detail;
+  EXPECT_TRUE(report->success) << Verdict(*report);
   EXPECT_FALSE(report->failure.has_value());
-  EXPECT_EQ(report->tasks_total, static_cast<int>(p.plan->actions.size()));
+  EXPECT_EQ(report->tasks_total, static_cast<int>(plan().actions.size()));
   EXPECT_EQ(report->tasks_completed, report->tasks_total);
   for (const SimActionStatus& a : report->actions) EXPECT_EQ(a.status, "completed");
   // Some gripper carried something, within its limits; the assembly came out in one piece.
@@ -88,19 +129,23 @@ TEST(Sim, FullModelPlanHolds) {
   // Connections were made and held within their limits.
   EXPECT_GE(u.connection, 0.0);
   EXPECT_LE(u.connection, 1.0);
+  // Collisions were looked for along the whole run, and none was found.
+  EXPECT_EQ(report->motion, "trajectories");
+  EXPECT_TRUE(report->collisions_judged);
+  EXPECT_GT(report->collision_checks, 100);
   // The report as JSON says the same.
   const std::string json = SerializeSimReport(*report);
   EXPECT_NE(json.find("\"success\": true"), std::string::npos);
   EXPECT_NE(json.find("\"failure\": null"), std::string::npos);
+  EXPECT_NE(json.find("\"motion\": \"trajectories\""), std::string::npos);
 }
 
 // A part released in mid-air: a release inserted just after the first pick, while the part is
 // being lifted, drops it; the failure is "no support" at the inserted release.
-TEST(Sim, ReleaseInMidAirFailsWithNoSupport) {
-  const Planned& p = PlanOnce("half_stool");
-  ASSERT_TRUE(p.error.empty()) << p.error;
-  Plan broken = *p.plan;
-  const int pick = FirstPick(broken);
+TEST_F(Sim, ReleaseInMidAirFailsWithNoSupport) {
+  if (!Use("half_stool")) return;
+  Plan broken = plan();
+  const int pick = First(broken, ActionType::kPick);
   ASSERT_GE(pick, 0);
   // Half way through the carry that follows the picking robot's lift: the part is high up.
   const int robot = broken.actions[pick].robots[0];
@@ -123,7 +168,7 @@ TEST(Sim, ReleaseInMidAirFailsWithNoSupport) {
   release.start_s = release.end_s = lifted_s;
   broken.actions.insert(broken.actions.begin() + pick + 1, release);
 
-  auto report = Simulate(p, broken);
+  auto report = Simulate(broken);
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_FALSE(report->success);
   ASSERT_TRUE(report->failure.has_value());
@@ -138,26 +183,17 @@ TEST(Sim, ReleaseInMidAirFailsWithNoSupport) {
 // An insertion pressed against a vacuum gripper sideways: the cube's plan (vacuum grippers
 // only) simulated with the first assembled step's insertion axis turned by 90 degrees, so the
 // mating force pushes across the suction cup, which holds no lateral force while mating.
-TEST(Sim, SidewaysInsertionOnVacuumFailsWithVacuumLimit) {
-  const Planned& p = PlanOnce("cube");
-  ASSERT_TRUE(p.error.empty()) << p.error;
-  const Plan& plan = *p.plan;
-  const AssemblyTree& tree = *p.lp.check.tree;
-  int assemble = -1;
-  for (size_t i = 0; i < plan.actions.size(); ++i) {
-    const PlanAction& a = plan.actions[i];
-    if (a.type != ActionType::kAssemble) continue;
-    if (assemble < 0 || a.end_s < plan.actions[assemble].end_s) assemble = static_cast<int>(i);
-  }
+TEST_F(Sim, SidewaysInsertionOnVacuumFailsWithVacuumLimit) {
+  if (!Use("cube")) return;
+  const int assemble = FirstAssembleInTime(plan());
   ASSERT_GE(assemble, 0);
-  Project sideways = *p.lp.project;
-  Mating& mating = sideways.steps[tree.nodes[plan.actions[assemble].objects[2]].step].mating;
+  Project sideways = project();
+  Mating& mating = sideways.steps[tree().nodes[plan().actions[assemble].objects[2]].step].mating;
   const Vec3 axis = mating.axis.normalized();
   const Vec3 other = std::abs(axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
   mating.axis = axis.cross(other).normalized();
 
-  RunContext ctx(0);
-  auto report = SimulatePlan(sideways, p.lp.check, p.file, plan, SimOptions{}, ctx);
+  auto report = Simulate(plan(), {}, &sideways);
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_FALSE(report->success);
   ASSERT_TRUE(report->failure.has_value());
@@ -166,47 +202,36 @@ TEST(Sim, SidewaysInsertionOnVacuumFailsWithVacuumLimit) {
   EXPECT_GT(report->peak.vacuum_insertion, 1.0);
 
   // The same plan with the project's own axis holds through that insertion.
-  RunContext ctx2(0);
-  auto nominal = SimulatePlan(*p.lp.project, p.lp.check, p.file, plan, SimOptions{}, ctx2);
+  auto nominal = Simulate(plan());
   ASSERT_TRUE(nominal) << nominal.error().message;
-  EXPECT_TRUE(nominal->success) << nominal->failure->reason << " at action "
-                                << nominal->failure->action << ": " << nominal->failure->detail;
+  EXPECT_TRUE(nominal->success) << Verdict(*nominal);
   EXPECT_LE(nominal->peak.vacuum_insertion, 1.0);
 }
 
 // A moved part that does not meet its base where the assembly has it: the project's assembled
 // pose of the first assemble's moved part is shifted 2 cm across the insertion axis after
 // planning, so the plan mates it off by that much.
-TEST(Sim, OffsetMatingFailsWithMisalignment) {
-  const Planned& p = PlanOnce("half_stool");
-  ASSERT_TRUE(p.error.empty()) << p.error;
-  const Plan& plan = *p.plan;
-  const AssemblyTree& tree = *p.lp.check.tree;
-  int assemble = -1;
-  for (size_t i = 0; i < plan.actions.size(); ++i) {
-    const PlanAction& a = plan.actions[i];
-    if (a.type != ActionType::kAssemble) continue;
-    if (assemble < 0 || a.end_s < plan.actions[assemble].end_s) assemble = static_cast<int>(i);
-  }
+TEST_F(Sim, OffsetMatingFailsWithMisalignment) {
+  if (!Use("half_stool")) return;
+  const int assemble = FirstAssembleInTime(plan());
   ASSERT_GE(assemble, 0);
-  const int moved = plan.actions[assemble].objects[0];
-  ASSERT_EQ(tree.nodes[moved].parts.size(), 1u) << "expected a single part moved first";
-  Project shifted = *p.lp.project;
-  Part& part = shifted.parts[tree.nodes[moved].parts.front()];
-  const Mating& mating = shifted.steps[tree.nodes[plan.actions[assemble].objects[2]].step].mating;
+  const int moved = plan().actions[assemble].objects[0];
+  ASSERT_EQ(tree().nodes[moved].parts.size(), 1u) << "expected a single part moved first";
+  Project shifted = project();
+  Part& part = shifted.parts[tree().nodes[moved].parts.front()];
+  const Mating& mating = shifted.steps[tree().nodes[plan().actions[assemble].objects[2]].step].mating;
   const Vec3 axis = mating.axis.normalized();
   const Vec3 across = axis.cross(std::abs(axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY());
   const Iso3 X_AP = ToIsometry(part.assembled_pose);
   part.assembled_pose.xyz += 0.02 * across.normalized();
   // The part starts where it did (the plan's initial objects are frames A, parts sit at
   // X_WA X_AP): only where the assembly wants it differs.
-  Plan same_start = plan;
+  Plan same_start = plan();
   for (PlanObject& o : same_start.initial.objects) {
     if (o.node == moved) o.X_WA = o.X_WA * X_AP * ToIsometry(part.assembled_pose).inverse();
   }
 
-  RunContext ctx(0);
-  auto report = SimulatePlan(shifted, p.lp.check, p.file, same_start, SimOptions{}, ctx);
+  auto report = Simulate(same_start, {}, &shifted);
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_FALSE(report->success);
   ASSERT_TRUE(report->failure.has_value());
@@ -214,19 +239,148 @@ TEST(Sim, OffsetMatingFailsWithMisalignment) {
   EXPECT_EQ(report->failure->action, assemble) << report->failure->detail;
 }
 
-TEST(Sim, PlanWithoutMotionIsBadInput) {
-  const Planned& p = PlanOnce("half_stool");
-  ASSERT_TRUE(p.error.empty()) << p.error;
-  Plan task_only = *p.plan;
+// A robot moved through the cell: while the first pick's robot approaches its part, another
+// robot, idle then, is put (by IK) where that gripper is. The run fails with "collision" at the
+// pick, naming a body of the moved robot (it meets the other robot, or a part on its way); the
+// same run with collisions not judged holds.
+TEST_F(Sim, RobotMovedThroughTheCellFailsWithCollision) {
+  if (!Use("half_stool")) return;
+  Plan broken = plan();
+  const int pick = First(broken, ActionType::kPick);
+  ASSERT_GE(pick, 0);
+  const int picker = broken.actions[pick].robots[0];
+  const int other = picker == 0 ? 1 : 0;
+  double t = -1.0;
+  for (const MotionSegment& s : broken.segments) {
+    if (s.kind == "approach" && s.action == pick) t = 0.5 * (s.start_s + s.end_s);
+  }
+  ASSERT_GT(t, 0.0) << "no approach to the first pick";
+  auto scene = BuildCellScene(project(), p_->lp.check, p_->file);
+  ASSERT_TRUE(scene) << scene.error().message;
+  const SceneRobot& a = scene->robots[picker];
+  const SceneRobot& b = scene->robots[other];
+  RobotTrajectory& tr = broken.trajectories[other];
+  const JointVector idle = SampleTrajectory(tr, t);
+  ASSERT_LT((SampleTrajectory(tr, t + 0.3) - idle).cwiseAbs().maxCoeff(), 1e-9)
+      << "the other robot is not idle during the approach";
+  // The other robot's TCP onto the picker's, turned half way round (facing it).
+  const Iso3 X_WT = TcpPose(a.chain, a.X_WB, SampleTrajectory(broken.trajectories[picker], t),
+                            a.end_effector.X_FT);
+  NumericIkRequest request;
+  request.X_BT = b.X_WB.inverse() * X_WT * Eigen::AngleAxisd(M_PI, Vec3::UnitX());
+  request.X_FT = b.end_effector.X_FT;
+  request.seeds = {idle};
+  std::mt19937_64 rng(1);
+  NumericIkOptions ik_options;
+  ik_options.restarts = 200;
+  ik_options.position_tolerance_m = 1e-3;
+  ik_options.rotation_tolerance_rad = 0.5;
+  auto ik = SolveNumericIk(b.chain, request, rng, ik_options);
+  ASSERT_TRUE(ik) << ik.error().message;
+  // Knots (constant acceleration between them, here none): there from t to t + 0.3 s.
+  std::vector<TrajectoryKnot> knots;
+  for (const TrajectoryKnot& k : tr.knots) {
+    if (k.t < t) knots.push_back(k);
+  }
+  const JointVector zero = JointVector::Zero(idle.size());
+  knots.push_back({t, ik->q, zero, -1.0});
+  knots.push_back({t + 0.3, idle, zero, -1.0});
+  for (const TrajectoryKnot& k : tr.knots) {
+    if (k.t > t + 0.3) knots.push_back(k);
+  }
+  tr.knots = knots;
+
+  auto report = Simulate(broken);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_FALSE(report->success);
+  ASSERT_TRUE(report->failure.has_value());
+  EXPECT_EQ(report->failure->reason, "collision") << report->failure->detail;
+  EXPECT_EQ(report->failure->action, pick) << report->failure->detail;
+  EXPECT_GE(report->failure->t_s, t);
+  EXPECT_LE(report->failure->t_s, t + 0.3);
+  EXPECT_NE(report->failure->detail.find("'" + b.name + "/"), std::string::npos)
+      << report->failure->detail;
+
+  SimOptions blind;
+  blind.check_collisions = false;
+  auto unchecked = Simulate(broken, blind);
+  ASSERT_TRUE(unchecked) << unchecked.error().message;
+  EXPECT_TRUE(unchecked->success) << Verdict(*unchecked);
+  EXPECT_FALSE(unchecked->collisions_judged);
+}
+
+// A part moved into a gripper's way: the part the first pick's robot does not grasp is put, on
+// the table, where the grasped one stands, so the gripper meets it on its way in.
+TEST_F(Sim, PartInTheGrippersWayFailsWithCollision) {
+  if (!Use("half_stool")) return;
+  Plan broken = plan();
+  const int pick = First(broken, ActionType::kPick);
+  ASSERT_GE(pick, 0);
+  const int picked = broken.actions[pick].objects[0];
+  // Another single part of the same shape that rests untouched until later (the other leg).
+  int moved = -1;
+  for (const PlanObject& o : broken.initial.objects) {
+    if (o.node != picked && tree().nodes[o.node].parts.size() == 1 &&
+        project().parts[tree().nodes[o.node].parts[0]].mesh ==
+            project().parts[tree().nodes[picked].parts[0]].mesh) {
+      moved = o.node;
+    }
+  }
+  ASSERT_GE(moved, 0) << "no part like the first picked one";
+  Iso3 X_W_picked = Iso3::Identity(), X_W_moved = Iso3::Identity();
+  for (const PlanObject& o : broken.initial.objects) {
+    if (o.node == picked) X_W_picked = o.X_WA * ToIsometry(project().parts[picked].assembled_pose);
+    if (o.node == moved) X_W_moved = o.X_WA * ToIsometry(project().parts[moved].assembled_pose);
+  }
+  // Same height and orientation on the table, shifted sideways onto the picked part.
+  Vec3 shift = X_W_picked.translation() - X_W_moved.translation();
+  shift.z() = 0.0;
+  for (PlanObject& o : broken.initial.objects) {
+    if (o.node == moved) o.X_WA.translation() += shift;
+  }
+
+  auto report = Simulate(broken);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_FALSE(report->success);
+  ASSERT_TRUE(report->failure.has_value());
+  EXPECT_EQ(report->failure->reason, "collision") << report->failure->detail;
+  EXPECT_EQ(report->failure->action, pick) << report->failure->detail;
+  EXPECT_NE(report->failure->detail.find("'" + project().parts[moved].name + "'"),
+            std::string::npos)
+      << report->failure->detail;
+}
+
+// A plan without motion is replayed from its keyframes: it holds (the full wrench model), says
+// so, and judges no collisions.
+TEST_F(Sim, PlanWithoutMotionReplaysItsKeyframes) {
+  if (!Use("half_stool")) return;
+  Plan task_only = plan();
   task_only.trajectories.clear();
-  auto report = Simulate(p, task_only);
-  ASSERT_FALSE(report);
-  EXPECT_EQ(report.error().code, ErrorCode::kInvalidInput);
-  EXPECT_NE(report.error().message.find("trajectories"), std::string::npos);
+  task_only.segments.clear();
+  for (PlanAction& a : task_only.actions) a.start_s = a.end_s = -1.0;
+  auto report = Simulate(task_only);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_EQ(report->motion, "keyframes");
+  EXPECT_FALSE(report->collisions_judged);
+  EXPECT_TRUE(report->success) << Verdict(*report);
+  EXPECT_EQ(report->tasks_completed, report->tasks_total);
+  EXPECT_GT(report->peak.two_finger_transport, 0.0);
+  EXPECT_GT(report->peak.two_finger_insertion, 0.0);
+  ASSERT_FALSE(report->notes.empty());
+  EXPECT_NE(report->notes.front().find("keyframes"), std::string::npos);
+  EXPECT_NE(SerializeSimReport(*report).find("\"motion\": \"keyframes\""), std::string::npos);
+
+  // Trajectories that do not fit the cell are still bad input.
+  Plan wrong = plan();
+  wrong.trajectories.pop_back();
+  auto bad = Simulate(wrong);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ErrorCode::kInvalidInput);
+  EXPECT_NE(bad.error().message.find("trajectories"), std::string::npos);
 }
 
 // MuJoCo's errors (which exit the process by default) come back as messages.
-TEST(Sim, MujocoErrorsBecomeMessages) {
+TEST(SimMujoco, MujocoErrorsBecomeMessages) {
   InstallMujocoHandlers();
   auto guarded = RunGuarded("a deliberate error", [] { mju_error_i("deliberate failure %d", 42); });
   ASSERT_FALSE(guarded);
