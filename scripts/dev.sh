@@ -7,6 +7,8 @@
 #   scripts/dev.sh build  install and build only
 #   scripts/dev.sh sanitize     install, build everything with ASan + UBSan (-DWRAP_SANITIZE=ON)
 #                               into build-asan and run the whole test suite there
+#   scripts/dev.sh soak   install, build, and plan every example project 50 times in one process
+#                         (the load tests with WRAP_SOAK_ROUNDS=50; about 25 CPU minutes)
 #   scripts/dev.sh sanitize-ci  the part of `sanitize` that CI runs: no UI, only the suites in
 #                               SANITIZE_CI_SUITES below (core, model, geometry, robot,
 #                               collision with URDF import, the fuzz regression and seed replay)
@@ -65,8 +67,12 @@ case "$mode" in
   test)
     ctest --test-dir "$BUILD_DIR" --output-on-failure --parallel "$(nproc)"
     ;;
+  soak)
+    WRAP_SOAK_ROUNDS=${WRAP_SOAK_ROUNDS:-50} "$BUILD_DIR/tests/load/load_test" \
+      --gtest_filter='Load.*Planned*'
+    ;;
   *)
-    echo "usage: scripts/dev.sh [demo|test|build|sanitize|sanitize-ci]" >&2
+    echo "usage: scripts/dev.sh [demo|test|build|soak|sanitize|sanitize-ci]" >&2
     exit 2
     ;;
 esac
