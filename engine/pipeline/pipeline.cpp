@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "motion/motion.h"
+#include "task/plan_validator.h"
 #include "task/world.h"
 
 namespace wrap {
@@ -32,9 +33,17 @@ struct Candidate {
 Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
                           const Preprocessed& pre, const PipelineOptions& options,
                           RunContext& ctx) {
+  // A solved plan carries each gripper's utilisation per action (for the GUI and reports); a
+  // failure to compute it leaves the plan as it is.
+  auto annotate = [&](Plan& plan) {
+    if (plan.stats.solved) (void)AnnotateUtilisation(project, check, plan, options.task.project_file);
+  };
   auto first = PlanTask(project, check, pre, options.task, ctx);
   if (!first) return first;
-  if (options.task_only || !first->stats.solved) return first;
+  if (options.task_only || !first->stats.solved) {
+    annotate(*first);
+    return first;
+  }
   auto world = BuildTaskWorld(project, check, pre, options.task.project_file);
   if (!world) return std::unexpected(world.error());
 
@@ -117,6 +126,7 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
       plan.stats.t_retime_s = t_retime;
       plan.stats.motion_suspensions = suspensions;
       plan.stats.task_plans = made;
+      annotate(plan);
       return plan;
     }
     const MotionFailure& f = attempt->failure;

@@ -32,6 +32,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -111,6 +112,10 @@ struct PlanAction {
   /// Once retimed: the moment of the keyframe (grasp closed, gripper about to open, mated), when
   /// every robot of `robots` is at its keyframe joints [s]; -1 without motion.
   double end_s = -1.0;
+  /// Each holding gripper's peak wrench utilisation at this action (robot index -> max_i |w_i| /
+  /// limit_i over the action's wrench gates of the full model; AnnotateUtilisation). Empty when
+  /// not computed.
+  std::map<int, double> utilisation;
 };
 
 /// A knot of a timed robot trajectory. Between two knots every joint moves with constant

@@ -157,6 +157,11 @@ ojson ActionJson(const Plan& plan, const PlanAction& a, size_t index) {
   if (a.end_s != -1.0) j["end_s"] = a.end_s;
   j["keyframe"] = KeyframeJson(plan, a.keyframe);
   if (a.approach) j["approach"] = KeyframeJson(plan, *a.approach);
+  if (!a.utilisation.empty()) {
+    ojson u = ojson::object();
+    for (const auto& [r, value] : a.utilisation) u[NameOr(plan.robots, r)] = value;
+    j["utilisation"] = u;
+  }
   j["description"] = DescribeAction(plan, a);
   return j;
 }
@@ -417,7 +422,7 @@ class PlanReader {
     ExpectObject(j, at);
     CheckKeys(j, at,
               {"index", "type", "robots", "objects", "grasps", "placement", "milestone", "start_s",
-               "end_s", "keyframe", "approach", "description"});
+               "end_s", "keyframe", "approach", "utilisation", "description"});
     PlanAction a;
     const int i = Int(j, at, "index");
     if (i != static_cast<int>(index)) {
@@ -484,6 +489,19 @@ class PlanReader {
         Bad(Join(at, "approach"), "only an assemble action has an approach keyframe");
       }
       a.approach = ReadKeyframe(j, at, "approach");
+    }
+    if (const json* u = Find(j, "utilisation")) {
+      const std::string u_at = Join(at, "utilisation");
+      ExpectObject(*u, u_at);
+      for (const auto& [name, value] : u->items()) {
+        const std::string v_at = Join(u_at, name);
+        const auto it = std::find(plan_.robots.begin(), plan_.robots.end(), name);
+        if (it == plan_.robots.end()) Bad(v_at, "no robot '" + name + "' in the plan");
+        if (!value.is_number() || !std::isfinite(value.get<double>()) || value.get<double>() < 0) {
+          Bad(v_at, "expected a non-negative number (a gripper's utilisation)");
+        }
+        a.utilisation[static_cast<int>(it - plan_.robots.begin())] = value.get<double>();
+      }
     }
     if (const json* d = Find(j, "description")) StringValue(*d, Join(at, "description"));
     return a;

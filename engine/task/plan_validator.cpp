@@ -841,8 +841,19 @@ void Validator::RunGate(int index, WrenchGate gate, const StepConfiguration& con
   auto check = checker_->Check(config, query);
   if (!check) {
     Issue(index, name, what + ": the wrench check could not run: " + check.error().message);
-  } else if (!check->feasible) {
-    Issue(index, name, what + ": " + check->reason);
+    return;
+  }
+  if (!check->feasible) Issue(index, name, what + ": " + check->reason);
+  if (index < 0) return;
+  if (out_.utilisation.size() <= static_cast<size_t>(index)) out_.utilisation.resize(index + 1);
+  for (const SupportLoad& load : check->supports) {
+    if (load.kind != SupportKind::kGripper || !std::isfinite(load.utilisation)) continue;
+    const std::string& who = config.grippers[static_cast<size_t>(load.index)].name;
+    for (size_t r = 0; r < robots_.size(); ++r) {
+      if (robots_[r].name != who) continue;
+      double& u = out_.utilisation[static_cast<size_t>(index)][static_cast<int>(r)];
+      u = std::max(u, load.utilisation);
+    }
   }
 }
 
@@ -1257,6 +1268,22 @@ PlanValidation Validator::Run() {
 }
 
 }  // namespace
+
+Result<void> AnnotateUtilisation(const Project& project, const ProjectCheck& check, Plan& plan,
+                                 const std::filesystem::path& project_file) {
+  PlanValidationOptions options;
+  options.check_collisions = false;
+  options.wrench_mode = MatingWrenchMode::kFull;
+  options.force_scale = plan.stats.force_scale;
+  options.require_complete = false;
+  auto v = ValidatePlan(project, check, plan, options, project_file);
+  if (!v) return std::unexpected(v.error());
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    plan.actions[i].utilisation =
+        i < v->utilisation.size() ? v->utilisation[i] : std::map<int, double>{};
+  }
+  return {};
+}
 
 Result<PlanValidation> ValidatePlan(const Project& project, const ProjectCheck& check,
                                     const Plan& plan, const PlanValidationOptions& options,

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -73,6 +74,10 @@ struct PlanValidation {
   int keyframes = 0;              ///< Keyframes checked (initial, action and approach keyframes).
   int collision_checks = 0;       ///< Collision queries run.
   int wrench_checks = 0;          ///< Wrench gates solved.
+  /// Per action (Plan::actions' order): each holding gripper's peak utilisation over the wrench
+  /// gates solved at that action (robot index -> max_i |w_i| / limit_i, worst case over the
+  /// uncertainty set; above 1 where a gate fails). Empty where no gate ran.
+  std::vector<std::map<int, double>> utilisation;
 
   /// True when some issue has `gate`, at `action` unless `action` is kAnyAction.
   bool HasIssue(std::string_view gate, int action = kAnyAction) const;
@@ -99,6 +104,13 @@ std::string FormatIssue(const PlanIssue& issue);
 /// the plan cannot be interpreted: a robot, part or node index out of range, a keyframe without
 /// one joint vector of the right size per robot, a project without a DAG or a mesh, a robot model
 /// or end effector that does not load; and with kInvalidInput for options out of range.
+/// Fills every action's PlanAction::utilisation: the wrench gates of the full model at the
+/// plan's lambda (stats.force_scale), solved at each action's keyframe, whatever model the plan
+/// was made with (so a plan made without the wrench model shows where it asks too much);
+/// collisions are not checked and the plan is not judged. Fails like ValidatePlan.
+Result<void> AnnotateUtilisation(const Project& project, const ProjectCheck& check, Plan& plan,
+                                 const std::filesystem::path& project_file = {});
+
 Result<PlanValidation> ValidatePlan(const Project& project, const ProjectCheck& check,
                                     const Plan& plan, const PlanValidationOptions& options,
                                     const std::filesystem::path& project_file);

@@ -51,6 +51,21 @@ TEST(PlanCli, PlansValidatesAndWritesThePlan) {
   ASSERT_FALSE(plan["actions"].empty());
   EXPECT_TRUE(plan["actions"][0].contains("keyframe"));
   EXPECT_TRUE(plan["actions"][0]["keyframe"]["q"].contains("left"));
+  // Every assemble says how hard each gripper holding its inputs works (full wrench model; a
+  // validated plan stays within the limits).
+  int assembles = 0;
+  for (const auto& a : plan["actions"]) {
+    if (a["type"] != "assemble") continue;
+    ++assembles;
+    ASSERT_TRUE(a.contains("utilisation")) << a.dump();
+    for (const auto& who : a["robots"]) {
+      ASSERT_TRUE(a["utilisation"].contains(who.get<std::string>())) << a.dump();
+      const double u = a["utilisation"][who.get<std::string>()].get<double>();
+      EXPECT_GT(u, 0.0) << a.dump();
+      EXPECT_LE(u, 1.0 + 1e-6) << a.dump();
+    }
+  }
+  EXPECT_EQ(assembles, 2);
 
   // `wrap validate --plan` also checks the trajectories of a plan with motion, and catches a
   // knot moved off its path.

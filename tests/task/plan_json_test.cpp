@@ -273,6 +273,35 @@ TEST(PlanJson, RoundTripIsExact) {
   EXPECT_EQ(a["initial"]["q"], b["initial"]["q"]);
 }
 
+// Per-action gripper utilisation: written by robot name, read back exactly, and checked.
+TEST(PlanJson, UtilisationRoundTripsAndIsChecked) {
+  Plan plan = StoolPlan();
+  plan.actions[1].utilisation = {{0, 0.625}, {2, 1.25}};
+  const std::string text = SerializePlan(plan);
+  auto parsed = ParsePlan(text, "plan.json");
+  ASSERT_TRUE(parsed.has_value()) << parsed.error().message;
+  EXPECT_EQ(parsed->actions[1].utilisation, plan.actions[1].utilisation);
+  EXPECT_TRUE(parsed->actions[0].utilisation.empty());
+  json d = json::parse(text);
+  EXPECT_EQ(d["actions"][1]["utilisation"]["ur5e_a"], 0.625);
+  EXPECT_EQ(d["actions"][1]["utilisation"]["ur5e_c"], 1.25);
+  EXPECT_FALSE(d["actions"][0].contains("utilisation"));
+  json unknown = d;
+  unknown["actions"][1]["utilisation"]["nobody"] = 0.5;
+  auto bad = ParsePlan(unknown.dump(), "plan.json");
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find("actions[1].utilisation.nobody: no robot 'nobody'"),
+            std::string::npos)
+      << bad.error().message;
+  json negative = d;
+  negative["actions"][1]["utilisation"]["ur5e_a"] = -0.1;
+  bad = ParsePlan(negative.dump(), "plan.json");
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find("actions[1].utilisation.ur5e_a: expected a non-negative"),
+            std::string::npos)
+      << bad.error().message;
+}
+
 TEST(PlanJson, DocumentLayout) {
   const json doc = json::parse(SerializePlan(StoolPlan()));
   std::vector<std::string> keys;

@@ -205,6 +205,29 @@ TEST_F(PlanValidatorTest, PickAndPlaceValidates) {
   EXPECT_TRUE(full.HasIssue("incomplete", 1)) << Issues(full);
 }
 
+// The gripper utilisation the validator reports: only the robot that holds the leg carries a load
+// after the pick; alone in the air the leg's wrench on the gripper is fixed by equilibrium, so
+// doubling every limit of the gripper halves its utilisation exactly.
+TEST_F(PlanValidatorTest, UtilisationOfTheHoldingGripperScalesWithItsLimits) {
+  BuildPickPlace();
+  WrenchLimits limits;
+  limits.two_finger = WrenchBox{Vec3::Constant(40.0), Vec3::Constant(4.0)};
+  project_.robots[kRobotA].wrench_limits = limits;
+  const PlanValidation v = Validate();
+  EXPECT_TRUE(v.valid) << Issues(v);
+  ASSERT_GE(v.utilisation.size(), 1u);
+  ASSERT_EQ(v.utilisation[0].size(), 1u);
+  ASSERT_TRUE(v.utilisation[0].count(kRobotA));
+  const double u = v.utilisation[0].at(kRobotA);
+  EXPECT_GT(u, 0.0);
+  EXPECT_LT(u, 1.0);
+  limits.two_finger = WrenchBox{Vec3::Constant(80.0), Vec3::Constant(8.0)};
+  project_.robots[kRobotA].wrench_limits = limits;
+  const PlanValidation doubled = Validate();
+  ASSERT_TRUE(doubled.utilisation.size() >= 1u && doubled.utilisation[0].count(kRobotA));
+  EXPECT_NEAR(doubled.utilisation[0].at(kRobotA), u / 2, 1e-9 * u);
+}
+
 TEST_F(PlanValidatorTest, CorruptedJointsGiveFk) {
   BuildPickPlace();
   plan_.actions[1].keyframe.q[kRobotA][0] += 0.2;

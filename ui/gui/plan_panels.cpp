@@ -9,6 +9,19 @@
 
 namespace wrap::gui {
 
+namespace {
+
+// Green at no load, through yellow (70%), to red at the limit and beyond.
+ImU32 UtilisationColour(double u) {
+  const double x = std::clamp(u, 0.0, 1.0);
+  const double r = x < 0.7 ? x / 0.7 : 1.0;
+  const double g = x < 0.7 ? 1.0 : std::max(0.0, 1.0 - (x - 0.7) / 0.3);
+  return IM_COL32(static_cast<int>(60 + 195 * r), static_cast<int>(60 + 160 * g), 60, 255);
+}
+
+}  // namespace
+
+
 double AppState::Duration() const {
   if (!plan) return 0.0;
   if (plan->stats.motion && !plan->trajectories.empty()) {
@@ -161,6 +174,12 @@ void PlanPanel::Draw(AppState& app, const PanelRect& r) {
                                                         : IM_COL32(120, 180, 120, 255);
       dl->AddRectFilled(ImVec2(x_of(start), y + 1),
                         ImVec2(std::max(x_of(end), x_of(start) + 2), y + lane_h - 1), col, 2.0f);
+      // The gripper's wrench utilisation at this action as a band along the bar's foot.
+      if (const auto u = a.utilisation.find(rb); u != a.utilisation.end()) {
+        dl->AddRectFilled(ImVec2(x_of(start), y + lane_h - 4),
+                          ImVec2(std::max(x_of(end), x_of(start) + 2), y + lane_h - 1),
+                          UtilisationColour(u->second));
+      }
     }
   }
   const float lanes_h = n_robots * (lane_h + 3);
@@ -173,13 +192,38 @@ void PlanPanel::Draw(AppState& app, const PanelRect& r) {
     pb.playing = false;
   }
 
+  // The wrench utilisation of the action under the cursor, per gripper.
+  int under = -1;
+  for (size_t i = 0; i < plan.actions.size() && under < 0; ++i) {
+    const double from = motion ? plan.actions[i].start_s : keyframe_time[i] - 1;
+    if (pb.t >= from && pb.t <= keyframe_time[i]) under = static_cast<int>(i);
+  }
+  if (under >= 0 && !plan.actions[under].utilisation.empty()) {
+    ImGui::Text("Action %d, wrench utilisation:", under + 1);
+    for (const auto& [robot, u] : plan.actions[under].utilisation) {
+      ImGui::SameLine();
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(UtilisationColour(u)), "%s %.0f%%",
+                         plan.robots[robot].c_str(), 100.0 * u);
+    }
+  } else if (under >= 0) {
+    ImGui::TextDisabled("Action %d: no gripper carries a load", under + 1);
+  } else {
+    ImGui::TextDisabled("Between actions");
+  }
+
   // Actions in words; click to jump to the action's moment.
   ImGui::BeginChild("actions", ImVec2(0, 0), true);
   for (size_t i = 0; i < plan.actions.size(); ++i) {
     const double at = keyframe_time[i];
     const double from = motion ? plan.actions[i].start_s : at - 1;
     const bool current = pb.t >= from && pb.t <= at;
-    const std::string line = std::to_string(i + 1) + ". " + DescribeAction(plan, plan.actions[i]);
+    std::string line = std::to_string(i + 1) + ". " + DescribeAction(plan, plan.actions[i]);
+    if (!plan.actions[i].utilisation.empty()) {
+      double peak = 0.0;
+      for (const auto& [robot, u] : plan.actions[i].utilisation) peak = std::max(peak, u);
+      line += "  (peak gripper load " + std::to_string(static_cast<int>(std::lround(100 * peak))) +
+              "%)";
+    }
     if (ImGui::Selectable(line.c_str(), current)) {
       pb.t = at;
       pb.playing = false;
