@@ -33,6 +33,15 @@ const std::vector<std::string> kPlannerOrder = {"optimistic", "wrap",  "flat",
                                                 "counting",   "exact", "fine"};
 const std::vector<std::string> kComparisonProjects = {
     "cross", "stool", "chair", "fabrica_beam", "fabrica_plumbers_block", "fabrica_car"};
+
+// The paper's assemblies in its tables' order, then the other projects of `projects` by name.
+std::vector<std::string> ProjectOrder(const std::set<std::string>& projects) {
+  std::vector<std::string> order = kComparisonProjects;
+  for (const std::string& p : projects) {
+    if (std::find(order.begin(), order.end(), p) == order.end()) order.push_back(p);
+  }
+  return order;
+}
 const std::vector<std::string> kPalette = {"#111111", "#0072B2", "#999999", "#009E73",
                                            "#D55E00", "#CC79A7", "#E69F00", "#56B4E9"};
 
@@ -227,10 +236,7 @@ class ReportBuilder {
         "mean ± std over the solved runs; the paper's mean beside ours and the ratio ours / "
         "paper (below 1: we are faster or cheaper). Task plans only (`--task-only`).");
     std::vector<std::vector<std::string>> rows;
-    std::vector<std::string> order = kComparisonProjects;
-    for (const std::string& p : projects) {
-      if (std::find(order.begin(), order.end(), p) == order.end()) order.push_back(p);
-    }
+    const std::vector<std::string> order = ProjectOrder(projects);
     for (const std::string& p : order) {
       if (!projects.contains(p)) continue;
       for (const std::string& planner : kPlannerOrder) {
@@ -280,10 +286,7 @@ class ReportBuilder {
         "only, also where it failed: then the time until it gave up); `motion` counts the runs "
         "whose motion and retiming succeeded (and the mean makespan of their plans).");
     std::vector<std::vector<std::string>> rows;
-    std::vector<std::string> order = kComparisonProjects;
-    for (const std::string& p : projects) {
-      if (std::find(order.begin(), order.end(), p) == order.end()) order.push_back(p);
-    }
+    const std::vector<std::string> order = ProjectOrder(projects);
     for (const std::string& p : order) {
       if (!projects.contains(p)) continue;
       auto runs = Select([&](const RunResult& r) {
