@@ -13,6 +13,7 @@ namespace {
 
 using testing::ExampleProject;
 using testing::OpenStool;
+namespace fs = std::filesystem;
 
 /// Runs `command` on `doc`, checks that it changed the project, that undo gives back exactly
 /// the project before and redo exactly the project after; leaves it done.
@@ -231,6 +232,57 @@ TEST(RobotCommands, AddEditRemoveFromTheCatalog) {
 
   ExpectDoesAndUndoes(doc, RemoveRobot("big"));
   EXPECT_EQ(doc.project().robots.size(), 4u);
+}
+
+TEST(RobotCommands, AddFromAUrdf) {
+  Document doc = OpenStool();
+  const fs::path urdf = fs::path(WRAP_SOURCE_DIR) / "tests/fuzz/seeds/urdf/three_joint_arm.urdf";
+  auto robot = PrepareUrdfRobot(doc.project(), ExampleProject("stool"), urdf, "", "", "vacuum_cup");
+  ASSERT_TRUE(robot) << robot.error().message;
+  EXPECT_EQ(robot->name, "three_joint_arm");
+  EXPECT_EQ(robot->urdf, "../tests/fuzz/seeds/urdf/three_joint_arm.urdf")
+      << "relative to the project's folder";
+  EXPECT_TRUE(robot->model.empty());
+  EXPECT_EQ(robot->end_effector, "vacuum_cup");
+  EXPECT_DOUBLE_EQ(robot->base_pose.xyz.z(), doc.project().table.height);
+  ExpectDoesAndUndoes(doc, AddRobot(*robot));
+  EXPECT_EQ(doc.project().robots.back(), *robot);
+  // A second one gets a new name; the same name again is refused.
+  auto second = PrepareUrdfRobot(doc.project(), ExampleProject("stool"), urdf, "base_link",
+                                 "tool0", "robotiq_2f85");
+  ASSERT_TRUE(second) << second.error().message;
+  EXPECT_EQ(second->name, "three_joint_arm_2");
+  EXPECT_EQ(second->urdf_root, "base_link");
+  EXPECT_EQ(second->urdf_tip, "tool0");
+  ExpectRefused(doc, AddRobot(*robot), "already a robot");
+  // The project with the URDF robot passes the loader's checks (the chain loads from the path).
+  const ProjectCheck check = ValidateProject(doc.project(), ExampleProject("stool"));
+  for (const Diagnostic& d : check.diagnostics.items) ADD_FAILURE() << Format(d);
+}
+
+TEST(RobotCommands, UrdfErrorsNameTheFileAndTheProblem) {
+  Document doc = OpenStool();
+  const fs::path dir = fs::path(WRAP_SOURCE_DIR) / "tests/fuzz";
+  auto missing = PrepareUrdfRobot(doc.project(), ExampleProject("stool"), dir / "none.urdf", "",
+                                  "", "vacuum_cup");
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error().code, ErrorCode::kIo);
+  EXPECT_NE(missing.error().message.find("none.urdf"), std::string::npos)
+      << missing.error().message;
+  auto loop = PrepareUrdfRobot(doc.project(), ExampleProject("stool"),
+                               dir / "regressions/urdf/joint_from_link_to_itself.urdf", "", "",
+                               "vacuum_cup");
+  ASSERT_FALSE(loop);
+  EXPECT_EQ(loop.error().code, ErrorCode::kInvalidInput);
+  auto tip = PrepareUrdfRobot(doc.project(), ExampleProject("stool"),
+                              dir / "seeds/urdf/three_joint_arm.urdf", "", "no_such_link",
+                              "vacuum_cup");
+  ASSERT_FALSE(tip);
+  EXPECT_NE(tip.error().message.find("no_such_link"), std::string::npos) << tip.error().message;
+  auto ee = PrepareUrdfRobot(doc.project(), ExampleProject("stool"),
+                             dir / "seeds/urdf/three_joint_arm.urdf", "", "", "hand");
+  ASSERT_FALSE(ee);
+  EXPECT_NE(ee.error().message.find("not in the catalog"), std::string::npos);
 }
 
 TEST(RobotCommands, RefusesUnknownCatalogEntriesAndDuplicateNames) {

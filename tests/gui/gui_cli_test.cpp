@@ -80,6 +80,35 @@ RegionStats Stats(const render::Image& im, int x0, int y0, int x1, int y1,
   return s;
 }
 
+/// Pixels that differ (any channel by more than 24 levels) between two images of one size in a
+/// rectangle, and the mean "yellowness" (r + g - 2 b, levels) of those pixels in each image.
+struct PixelDiff {
+  long pixels = 0;
+  double yellowness_a = 0, yellowness_b = 0;
+};
+
+PixelDiff Diff(const render::Image& a, const render::Image& b, int x0, int y0, int x1, int y1) {
+  PixelDiff d;
+  for (int y = y0; y < y1; ++y) {
+    for (int x = x0; x < x1; ++x) {
+      const std::uint8_t* p = a.at(x, y);
+      const std::uint8_t* q = b.at(x, y);
+      if (std::abs(p[0] - q[0]) <= 24 && std::abs(p[1] - q[1]) <= 24 &&
+          std::abs(p[2] - q[2]) <= 24) {
+        continue;
+      }
+      ++d.pixels;
+      d.yellowness_a += p[0] + p[1] - 2.0 * p[2];
+      d.yellowness_b += q[0] + q[1] - 2.0 * q[2];
+    }
+  }
+  if (d.pixels > 0) {
+    d.yellowness_a /= static_cast<double>(d.pixels);
+    d.yellowness_b /= static_cast<double>(d.pixels);
+  }
+  return d;
+}
+
 // The layout at 1400x900 (ui/gui/app.cpp): left column 23 % (parts, robots), right 27 % (graph,
 // mating, planner), centre: viewport over the top two thirds, the plan panel below.
 constexpr int kW = 1400, kH = 900;
@@ -99,6 +128,8 @@ TEST(GuiCli, ScreenshotOfTheStoolAfterPlanningAndScrubbing) {
                                               "' --run-plan --at 40 --screenshot shot.png --size " +
                                               std::to_string(kW) + "x" + std::to_string(kH));
   ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("frames meanwhile"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" fps, drawing "), std::string::npos) << "the frame rate reported";
   auto im = render::ReadPng(dir / "shot.png");
   ASSERT_TRUE(im) << im.error().message;
   ASSERT_EQ(im->width, kW);
@@ -132,6 +163,7 @@ TEST(GuiCli, ScriptBuildsAProjectFromMeshesPlansAndSavesIt) {
     ASSERT_TRUE(blank.SaveAs(dir / "empty.json"));
   }
   const fs::path meshes = fs::path(WRAP_SOURCE_DIR) / "assets/parts/stool";
+  const fs::path kUrdf = fs::path(WRAP_SOURCE_DIR) / "tests/fuzz/seeds/urdf/three_joint_arm.urdf";
   std::ofstream(dir / "flow.wrapscript") << "# a half stool from meshes\n"
                                          << "import " << (meshes / "seat.stl").string() << " mm\n"
                                          << "import " << (meshes / "leg.stl").string() << " mm\n"
@@ -159,7 +191,16 @@ TEST(GuiCli, ScriptBuildsAProjectFromMeshesPlansAndSavesIt) {
                                          << "expect-plan\n"
                                          << "scrub 3\n"
                                          << "save built.json\n"
-                                         << "screenshot built.png\n";
+                                         << "screenshot built.png\n"
+                                         << "view quality fine\n"
+                                         << "screenshot tinted.png\n"
+                                         << "view utilisation off\n"
+                                         << "screenshot plain.png\n"
+                                         << "view quality fast\n"
+                                         << "screenshot fast.png\n"
+                                         << "add-urdf " << kUrdf.string() << " vacuum_cup\n"
+                                         << "expect-refused add-urdf missing.urdf vacuum_cup\n"
+                                         << "save with_urdf.json\n";
   const ProcessRun r = WrapUnderXvfb(dir, "empty.json --script flow.wrapscript --size 1400x900");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("ok 19: expect-refused"), std::string::npos) << r.output;
@@ -192,6 +233,31 @@ TEST(GuiCli, ScriptBuildsAProjectFromMeshesPlansAndSavesIt) {
   EXPECT_GT(scene.colours, 60) << "robots, parts, table, shadows: many colours";
   const RegionStats plan = Stats(*im, 330, 600, 1010, 880, {230, 140, 50});
   EXPECT_GT(plan.near_colour, 100) << "the plan's lanes";
+
+  // At the scrubbed action the loaded grippers are tinted by their utilisation (green through
+  // yellow to red, all with little blue): those pixels turn yellower than without the tint.
+  auto tinted = render::ReadPng(dir / "tinted.png");
+  auto plain = render::ReadPng(dir / "plain.png");
+  auto fast = render::ReadPng(dir / "fast.png");
+  ASSERT_TRUE(tinted && plain && fast);
+  const PixelDiff tint = Diff(*tinted, *plain, 340, 60, 1010, 560);
+  EXPECT_GT(tint.pixels, 30) << "grippers tinted";
+  EXPECT_GT(tint.yellowness_a, tint.yellowness_b + 20) << "tinted towards utilisation colours";
+  // Fast drawing: no shadows, no antialiasing: many pixels change, the scene is still drawn.
+  const PixelDiff quality = Diff(*plain, *fast, 340, 60, 1010, 560);
+  EXPECT_GT(quality.pixels, 2000) << "shadows gone";
+  EXPECT_GT(Stats(*fast, 340, 60, 1010, 560).colours, 30) << "the scene is drawn";
+
+  // The URDF robot: added with its path relative to the saved file; a missing URDF is refused.
+  auto with_urdf = Document::Open(dir / "with_urdf.json");
+  ASSERT_TRUE(with_urdf) << with_urdf.error().message;
+  ASSERT_EQ(with_urdf->project().robots.size(), 5u);
+  const Robot& arm = with_urdf->project().robots.back();
+  EXPECT_EQ(arm.name, "three_joint_arm");
+  EXPECT_TRUE(arm.model.empty());
+  EXPECT_EQ(arm.end_effector, "vacuum_cup");
+  EXPECT_TRUE(fs::exists(dir / arm.urdf)) << arm.urdf << " relative to the saved file";
+  EXPECT_TRUE(fs::path(arm.urdf).is_relative()) << arm.urdf;
 }
 
 TEST(GuiCli, BadScriptIsBadInputNamingTheLine) {

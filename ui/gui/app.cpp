@@ -79,14 +79,20 @@ class App {
     win_.BeginFrame();
     const double now = win_.time();
     const double dt = std::clamp(now - last_time_, 0.0, 0.2);
+    if (last_time_ > 0.0) {
+      s_.frames.Add(now - last_time_);
+      if (last_frame_fine_) fine_frame_s_ = now - last_time_;
+    }
     last_time_ = now;
     for (const std::string& f : win_.TakeDroppedFiles()) {
       if (IsMeshFile(f)) {
         parts_.Import(s_, f);
       } else if (fs::path(f).extension() == ".json") {
         RequestOpen(f);
+      } else if (fs::path(f).extension() == ".urdf") {
+        robots_.AddUrdf(s_, f);
       } else {
-        s_.Notify("Dropped file not recognised (a mesh or a project .json): " + f);
+        s_.Notify("Dropped file not recognised (a mesh, a robot .urdf or a project .json): " + f);
       }
     }
     TakePlan();
@@ -119,6 +125,7 @@ class App {
     StatusBar({0, H - status_h, W, status_h});
     Popups();
     UpdateViewport();
+    ChooseQuality();
     UpdateTitle();
     if (autosave_) {
       if (s_.doc.revision() != autosave_revision_) {
@@ -145,6 +152,19 @@ class App {
                            static_cast<int>(vr.w), static_cast<int>(vr.h));
         },
         capture);
+  }
+
+  /// The viewport's drawing quality for this frame. Auto: fine, unless something moves (the
+  /// planner runs, the plan plays, a mouse drag) and the last fine frame took longer than 1/20 s;
+  /// a still scene is drawn fine again.
+  void ChooseQuality() {
+    bool fine = s_.quality != QualityMode::kFast;
+    if (s_.quality == QualityMode::kAuto) {
+      const bool moving = s_.job.running() || s_.playback.playing || ImGui::IsAnyItemActive();
+      fine = !(moving && fine_frame_s_ > 1.0 / 20.0);
+    }
+    s_.viewport.set_quality(fine ? DrawQuality::kFine : DrawQuality::kFast);
+    last_frame_fine_ = fine;
   }
 
   bool quit() const { return quit_; }
@@ -240,6 +260,21 @@ class App {
     }
     if (ImGui::BeginMenu("View")) {
       if (ImGui::MenuItem("Reset camera")) s_.viewport.ResetCamera();
+      ImGui::Separator();
+      ImGui::TextDisabled("Drawing");
+      if (ImGui::MenuItem("Auto (fast while moving on slow GL)", nullptr,
+                          s_.quality == QualityMode::kAuto)) {
+        s_.quality = QualityMode::kAuto;
+      }
+      if (ImGui::MenuItem("Fine (antialiased, shadows)", nullptr,
+                          s_.quality == QualityMode::kFine)) {
+        s_.quality = QualityMode::kFine;
+      }
+      if (ImGui::MenuItem("Fast", nullptr, s_.quality == QualityMode::kFast)) {
+        s_.quality = QualityMode::kFast;
+      }
+      ImGui::MenuItem("Grippers coloured by wrench utilisation", nullptr, &s_.show_utilisation);
+      ImGui::Separator();
       if (ImGui::MenuItem("Auto layout of the graph")) graph_.AutoLayout(s_.doc.project());
       ImGui::EndMenu();
     }
@@ -381,6 +416,9 @@ class App {
         "##status", nullptr,
         ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings);
     ImGui::Text("%s%s", s_.doc.dirty() ? "* unsaved  " : "", s_.doc.path().string().c_str());
+    ImGui::SameLine();
+    ImGui::TextDisabled("|  %.0f fps%s", s_.frames.MedianFps(),
+                        s_.viewport.quality() == DrawQuality::kFast ? ", fast drawing" : "");
     if (!s_.messages.empty()) {
       ImGui::SameLine();
       ImGui::TextDisabled("|  %s", s_.messages.back().c_str());
@@ -421,6 +459,23 @@ class App {
     PlanMarks(state, selected, arrows, markers);
     s_.viewport.set_arrows(std::move(arrows));
     s_.viewport.set_markers(std::move(markers));
+    s_.viewport.set_gripper_tints(GripperTints(scene));
+  }
+
+  /// During playback, each gripper that carries a load in the action under the cursor tinted by
+  /// its wrench utilisation (the plan panel's colours); the others keep their colours.
+  std::vector<std::optional<Rgba>> GripperTints(const CellScene& scene) const {
+    std::vector<std::optional<Rgba>> tints(scene.robots.size());
+    if (!s_.show_utilisation || !s_.plan) return tints;
+    const int under = s_.ActionAt(s_.playback.t);
+    if (under < 0) return tints;
+    for (const auto& [robot, u] : s_.plan->actions[under].utilisation) {
+      if (robot < 0 || robot >= static_cast<int>(s_.plan->robots.size())) continue;
+      for (size_t r = 0; r < scene.robots.size(); ++r) {
+        if (scene.robots[r].name == s_.plan->robots[robot]) tints[r] = UtilisationColour(u);
+      }
+    }
+    return tints;
   }
 
   /// With a plan of this cell on show: the grasps it uses on the selected part (arrows along
@@ -569,6 +624,8 @@ class App {
   bool offer_recovery_ = false;
   bool quit_ = false;
   double last_time_ = 0.0, last_autosave_ = 0.0, last_edit_ = 0.0;
+  double fine_frame_s_ = 0.0;  // how long the last frame drawn fine took
+  bool last_frame_fine_ = true;
   bool autosave_ = false;
   unsigned long autosave_revision_ = 0;
   unsigned long autosave_failed_ = ~0UL;
@@ -641,7 +698,9 @@ int RunGui(const GuiOptions& options, std::ostream& out, std::ostream& err) {
       const JobProgress prog = s.job.progress();
       out << "Planner " << ToString(prog.state) << " in " << seconds << " s; the window drew "
           << frames << " frames meanwhile (" << (seconds > 0 ? frames / seconds : 0.0)
-          << " per second)\n";
+          << " per second; median of the last " << s.frames.size() << ": "
+          << s.frames.MedianFps() << " fps, drawing "
+          << (s.viewport.quality() == DrawQuality::kFast ? "fast" : "fine") << ")\n";
       if (prog.state != JobState::kSolved) {
         err << "wrap: planner: " << ToString(prog.state)
             << (prog.error.empty() ? "" : ": " + prog.error) << "\n";

@@ -16,6 +16,7 @@ namespace wrap::gui {
 
 using render::SceneArrow;
 using render::SceneMarker;
+using render::DrawQuality;
 using render::ViewportRenderer;
 
 /// What is selected, shared by the viewport, the DAG canvas and the editors.
@@ -33,6 +34,33 @@ struct Playback {
   bool loop = true;      ///< Start again at the end.
 };
 
+/// How the viewport chooses its drawing quality.
+enum class QualityMode {
+  kAuto,  ///< Fine, except fast while something moves (planner running, playback, a drag) on a
+          ///< machine where fine frames take longer than 1/20 s (software GL).
+  kFine,  ///< Always antialiased with shadows.
+  kFast,  ///< Always plain.
+};
+
+/// Frame times of the recent frames, for the frame rate shown and reported.
+class FrameStats {
+ public:
+  /// Records one frame's duration [s].
+  void Add(double seconds);
+  /// Median frame rate over the recent frames [1/s] (0 before any frame).
+  double MedianFps() const;
+  /// Forgets the recorded frames.
+  void Clear() { seconds_.clear(); }
+  size_t size() const { return seconds_.size(); }
+
+ private:
+  std::deque<double> seconds_;  // the last kKept
+  static constexpr size_t kKept = 60;
+};
+
+/// Green at no load, through yellow (70%), to red at the limit and beyond (r, g, b in [0, 1]).
+Rgba UtilisationColour(double utilisation);
+
 /// The shared state of the GUI.
 struct AppState {
   Document doc;                            ///< The project being edited.
@@ -47,6 +75,9 @@ struct AppState {
   std::string viewport_error;        ///< Why the cell could not be rebuilt ("" when it could).
   std::deque<std::string> messages;  ///< Recent messages for the status bar and log, newest last.
   std::vector<std::string> recent_files;  ///< Recently opened projects, newest first.
+  QualityMode quality = QualityMode::kAuto;  ///< Viewport drawing quality.
+  bool show_utilisation = true;  ///< Tint grippers by wrench utilisation during playback.
+  FrameStats frames;                       ///< Recent frame times.
 
   /// Adds a message (kept: the last 200).
   void Notify(std::string message) {
@@ -61,6 +92,11 @@ struct AppState {
   }
   /// The plan's timeline length: the makespan with motion, else the last keyframe's index.
   double Duration() const;
+  /// Index of the plan's action under timeline time `t` (its motion from start to end, or the
+  /// keyframe interval before its keyframe), or -1 (no plan, or between actions).
+  int ActionAt(double t) const;
+  /// The timeline time of each action's (last) keyframe.
+  std::vector<double> KeyframeTimes() const;
 };
 
 }  // namespace wrap::gui

@@ -6,6 +6,7 @@
 
 #include "geometry/mesh_import.h"
 #include "model/catalog.h"
+#include "robot/urdf_import.h"
 
 namespace wrap::gui {
 
@@ -325,24 +326,81 @@ Command SetMating(const std::string& step_name, Mating mating, std::string merge
 
 // ---- Robots ---------------------------------------------------------------------------------
 
+namespace {
+
+/// The corners of the table in turn, facing its centre.
+void PlaceAtNextCorner(const Project& p, Robot& robot) {
+  const int k = static_cast<int>(p.robots.size()) % 4;
+  const double sx = (k == 0 || k == 3) ? 1.0 : -1.0;
+  const double sy = k < 2 ? 1.0 : -1.0;
+  const double hx = 0.5 * p.table.size.x() - 0.15, hy = 0.5 * p.table.size.y() - 0.15;
+  robot.base_pose.xyz =
+      Vec3(p.table.center_xy.x() + sx * hx, p.table.center_xy.y() + sy * hy, p.table.height);
+  robot.base_pose.rpy = Vec3(0, 0, std::atan2(-sy * hy, -sx * hx));
+}
+
+/// `base`, or `base` followed by "_2", "_3", ...: the first robot name not taken.
+std::string UniqueRobotName(const Project& p, const std::string& base, bool number_first) {
+  auto taken = [&](const std::string& name) {
+    return std::any_of(p.robots.begin(), p.robots.end(),
+                       [&](const Robot& r) { return r.name == name; });
+  };
+  if (!number_first && !taken(base)) return base;
+  for (int i = number_first ? 1 : 2;; ++i) {
+    const std::string name = base + "_" + std::to_string(i);
+    if (!taken(name)) return name;
+  }
+}
+
+}  // namespace
+
 Command AddRobot(const std::string& model, const std::string& end_effector) {
   return {"add robot " + Quote(model), "", [model, end_effector](Project& p) -> Result<void> {
             Robot robot;
             robot.model = model;
             robot.end_effector = end_effector;
             if (auto ok = CheckCatalog(robot); !ok) return ok;
-            for (int i = 1;; ++i) {
-              robot.name = model + "_" + std::to_string(i);
-              if (!FindRobot(p, robot.name)) break;
+            robot.name = UniqueRobotName(p, model, true);
+            PlaceAtNextCorner(p, robot);
+            p.robots.push_back(robot);
+            return {};
+          }};
+}
+
+Result<Robot> PrepareUrdfRobot(const Project& project, const fs::path& project_file,
+                               const fs::path& urdf_file, const std::string& root,
+                               const std::string& tip, const std::string& end_effector) {
+  if (!FindEndEffector(end_effector)) {
+    return Refuse("end effector " + Quote(end_effector) + " is not in the catalog (" +
+                  EndEffectorNames() + ")");
+  }
+  UrdfImportOptions options;
+  options.root = root;
+  options.tip = tip;
+  options.import_visual = false;  // checked here; the cell loads the visuals when it is built
+  auto chain = ImportUrdf(urdf_file, options);
+  if (!chain) return std::unexpected(chain.error());
+  Robot robot;
+  const std::string stem = urdf_file.stem().string();
+  robot.name = UniqueRobotName(project, stem.empty() ? std::string("robot") : stem, false);
+  const fs::path dir = fs::absolute(project_file).parent_path();
+  const fs::path absolute = fs::absolute(urdf_file).lexically_normal();
+  const fs::path relative = absolute.lexically_relative(dir);
+  robot.urdf = relative.empty() ? absolute.string() : relative.generic_string();
+  robot.urdf_root = root;
+  robot.urdf_tip = tip;
+  robot.end_effector = end_effector;
+  PlaceAtNextCorner(project, robot);
+  return robot;
+}
+
+Command AddRobot(Robot robot) {
+  return {"add robot " + Quote(robot.name), "", [robot](Project& p) -> Result<void> {
+            if (robot.name.empty()) return Refuse("a robot name cannot be empty");
+            if (FindRobot(p, robot.name)) {
+              return Refuse("there is already a robot " + Quote(robot.name));
             }
-            // The corners of the table in turn, facing its centre.
-            const int k = static_cast<int>(p.robots.size()) % 4;
-            const double sx = (k == 0 || k == 3) ? 1.0 : -1.0;
-            const double sy = k < 2 ? 1.0 : -1.0;
-            const double hx = 0.5 * p.table.size.x() - 0.15, hy = 0.5 * p.table.size.y() - 0.15;
-            robot.base_pose.xyz = Vec3(p.table.center_xy.x() + sx * hx,
-                                       p.table.center_xy.y() + sy * hy, p.table.height);
-            robot.base_pose.rpy = Vec3(0, 0, std::atan2(-sy * hy, -sx * hx));
+            if (auto ok = CheckCatalog(robot); !ok) return ok;
             p.robots.push_back(robot);
             return {};
           }};

@@ -74,6 +74,18 @@ Result<void> CheckNewInput(const Project& project, const std::string& step,
 /// Adds a robot of catalog `model` with catalog `end_effector`, named "<model>_<n>", its base on
 /// the table edge at the next free corner. Refused for names not in the catalog.
 Command AddRobot(const std::string& model, const std::string& end_effector);
+/// A robot from the user's URDF `urdf_file`, ready for AddRobot: its chain from link `root` to
+/// link `tip` (empty: the URDF's root, its one tip; see ImportUrdf), end effector `end_effector`
+/// from the catalog, named after the file (made unique among the robots), the path written
+/// relative to the folder of `project_file`, its base at the next free table corner. Reads the
+/// URDF (and its meshes) to check it: fails with kIo or kInvalidInput naming the file and the
+/// problem (missing, malformed, no serial chain, an unknown end effector).
+Result<Robot> PrepareUrdfRobot(const Project& project, const std::filesystem::path& project_file,
+                               const std::filesystem::path& urdf_file, const std::string& root,
+                               const std::string& tip, const std::string& end_effector);
+/// Adds a prepared robot (e.g. from PrepareUrdfRobot). Refused for a name taken or a model or
+/// end effector not in the catalog.
+Command AddRobot(Robot robot);
 /// Removes the robot.
 Command RemoveRobot(const std::string& name);
 /// Replaces the robot `name` by `robot` (name unique; model and end effector from the catalog

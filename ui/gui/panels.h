@@ -20,11 +20,21 @@ struct PanelRect {
 void PlaceNextWindow(const PanelRect& r);
 
 /// Project settings, the parts list with import, and the selected part's properties.
+/// A small in-app file browser: a folder's subfolders and the files with one of `extensions`
+/// (lower case, with the dot), in a child window of the given height; a click on a file puts
+/// its path in `path`.
+struct FileBrowser {
+  std::string dir;    ///< Folder shown.
+  bool open = false;  ///< Shown.
+  /// Draws the "Browse..." toggle (starting in `start_dir`) and, when open, the list.
+  void Draw(const char* id, const std::vector<std::string>& extensions, const std::string& start_dir,
+            std::string& path);
+};
+
 struct PartsPanel {
   std::string import_path;    ///< Path field of the import.
   int import_unit = 2;        ///< Index into MeshUnits() (mm by default).
-  std::string browser_dir;    ///< Folder the in-app file browser shows.
-  bool browser_open = false;  ///< The browser is shown.
+  FileBrowser browser;        ///< Mesh files.
   /// Imports `path` with the chosen unit; messages say how it went.
   void Import(AppState& app, const std::string& path);
   void Draw(AppState& app, const PanelRect& r);
@@ -59,6 +69,11 @@ struct MatingPanel {
 struct RobotsPanel {
   int add_model = 0;  ///< Index into RobotModels().
   int add_ee = 0;     ///< Index into EndEffectors().
+  std::string urdf_path, urdf_root, urdf_tip;  ///< Fields of "Add from URDF".
+  FileBrowser browser;                         ///< URDF files.
+  /// Adds the robot of the URDF `path` with the chosen end effector and the root and tip
+  /// fields; messages say how it went.
+  void AddUrdf(AppState& app, const std::string& path);
   void Draw(AppState& app, const PanelRect& r);
 };
 

@@ -68,6 +68,38 @@ void PlaceNextWindow(const PanelRect& r) {
   ImGui::SetNextWindowSize(ImVec2(r.w, r.h), ImGuiCond_Always);
 }
 
+void FileBrowser::Draw(const char* id, const std::vector<std::string>& extensions,
+                       const std::string& start_dir, std::string& path) {
+  ImGui::PushID(id);
+  if (ImGui::Button(open ? "Hide files" : "Browse...")) {
+    open = !open;
+    if (dir.empty()) dir = start_dir;
+  }
+  if (open) {
+    ImGui::TextDisabled("%s", dir.c_str());
+    ImGui::BeginChild("browser", ImVec2(0, 140), true);
+    std::error_code ec;
+    if (ImGui::Selectable("..")) dir = fs::path(dir).parent_path().string();
+    std::vector<fs::directory_entry> entries;
+    for (const auto& e : fs::directory_iterator(dir, ec)) entries.push_back(e);
+    std::sort(entries.begin(), entries.end(),
+              [](const auto& a, const auto& b) { return a.path() < b.path(); });
+    for (const auto& e : entries) {
+      const std::string name = e.path().filename().string();
+      if (e.is_directory(ec)) {
+        if (ImGui::Selectable((name + "/").c_str())) dir = e.path().string();
+        continue;
+      }
+      std::string ext = e.path().extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+      if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) continue;
+      if (ImGui::Selectable(name.c_str(), path == e.path().string())) path = e.path().string();
+    }
+    ImGui::EndChild();
+  }
+  ImGui::PopID();
+}
+
 void PartsPanel::Import(AppState& app, const std::string& path) {
   PartImportOptions options;
   options.scale =
@@ -118,39 +150,8 @@ void PartsPanel::Draw(AppState& app, const PanelRect& r) {
     ImGui::SameLine();
     if (ImGui::Button("Import") && !import_path.empty()) Import(app, import_path);
     ImGui::SameLine();
-    if (ImGui::Button(browser_open ? "Hide files" : "Browse...")) {
-      browser_open = !browser_open;
-      if (browser_dir.empty()) browser_dir = app.doc.ResolvePath().parent_path().string();
-    }
-    if (browser_open) {
-      ImGui::TextDisabled("%s", browser_dir.c_str());
-      ImGui::BeginChild("browser", ImVec2(0, 140), true);
-      std::error_code ec;
-      if (ImGui::Selectable("..")) browser_dir = fs::path(browser_dir).parent_path().string();
-      std::vector<fs::directory_entry> entries;
-      for (const auto& e : fs::directory_iterator(browser_dir, ec)) entries.push_back(e);
-      std::sort(entries.begin(), entries.end(),
-                [](const auto& a, const auto& b) { return a.path() < b.path(); });
-      for (const auto& e : entries) {
-        const std::string name = e.path().filename().string();
-        if (e.is_directory(ec)) {
-          if (ImGui::Selectable((name + "/").c_str())) browser_dir = e.path().string();
-        } else {
-          std::string ext = e.path().extension().string();
-          std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-          static const char* kMeshes[] = {".stl", ".obj",  ".ply", ".off",
-                                          ".glb", ".gltf", ".3mf", ".dae"};
-          if (std::find_if(std::begin(kMeshes), std::end(kMeshes),
-                           [&](const char* m) { return ext == m; }) == std::end(kMeshes)) {
-            continue;
-          }
-          if (ImGui::Selectable(name.c_str(), import_path == e.path().string())) {
-            import_path = e.path().string();
-          }
-        }
-      }
-      ImGui::EndChild();
-    }
+    browser.Draw("meshes", {".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".3mf", ".dae"},
+                 app.doc.ResolvePath().parent_path().string(), import_path);
     ImGui::TextDisabled("or drop mesh files onto the window");
   }
 
@@ -281,6 +282,23 @@ void MatingPanel::Draw(AppState& app, const PanelRect& r) {
   ImGui::End();
 }
 
+void RobotsPanel::AddUrdf(AppState& app, const std::string& path) {
+  const auto& ees = EndEffectors();
+  const std::string ee =
+      ees.empty() ? std::string() : ees[std::clamp(add_ee, 0, static_cast<int>(ees.size()) - 1)].name;
+  auto robot = PrepareUrdfRobot(app.doc.project(), app.doc.ResolvePath(), path, urdf_root,
+                                urdf_tip, ee);
+  if (!robot) {
+    app.Notify("URDF robot not added: " + robot.error().message);
+    return;
+  }
+  const std::string name = robot->name;
+  if (app.Do(AddRobot(*robot))) {
+    app.selection.robot = name;
+    app.Notify("Added robot '" + name + "' from " + path);
+  }
+}
+
 void RobotsPanel::Draw(AppState& app, const PanelRect& r) {
   PlaceNextWindow(r);
   if (!ImGui::Begin("Robots", nullptr, ImGuiWindowFlags_NoCollapse)) {
@@ -314,6 +332,21 @@ void RobotsPanel::Draw(AppState& app, const PanelRect& r) {
         app.selection.robot = app.doc.project().robots.back().name;
       }
     }
+  }
+  // A user's arm from its URDF, with the end effector chosen above.
+  if (ImGui::TreeNode("Add from URDF")) {
+    ImGui::InputText("urdf file", &urdf_path);
+    ImGui::SetNextItemWidth(100);
+    ImGui::InputText("root link", &urdf_root);
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(100);
+    ImGui::InputText("tip link", &urdf_tip);
+    if (ImGui::Button("Add URDF robot") && !urdf_path.empty()) AddUrdf(app, urdf_path);
+    ImGui::SameLine();
+    browser.Draw("urdf", {".urdf"}, app.doc.ResolvePath().parent_path().string(), urdf_path);
+    ImGui::TextDisabled("or drop a .urdf file onto the window; links empty: the URDF's root\n"
+                        "and its one tip");
+    ImGui::TreePop();
   }
   for (const Robot& robot : p.robots) {
     const std::string label = robot.name + "  (" +

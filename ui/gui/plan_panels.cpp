@@ -11,16 +11,55 @@ namespace wrap::gui {
 
 namespace {
 
-// Green at no load, through yellow (70%), to red at the limit and beyond.
-ImU32 UtilisationColour(double u) {
-  const double x = std::clamp(u, 0.0, 1.0);
-  const double r = x < 0.7 ? x / 0.7 : 1.0;
-  const double g = x < 0.7 ? 1.0 : std::max(0.0, 1.0 - (x - 0.7) / 0.3);
-  return IM_COL32(static_cast<int>(60 + 195 * r), static_cast<int>(60 + 160 * g), 60, 255);
+ImU32 UtilisationImColour(double u) {
+  const Rgba c = UtilisationColour(u);
+  return IM_COL32(static_cast<int>(255 * c[0]), static_cast<int>(255 * c[1]),
+                  static_cast<int>(255 * c[2]), 255);
 }
 
 }  // namespace
 
+Rgba UtilisationColour(double u) {
+  const double x = std::clamp(u, 0.0, 1.0);
+  const double r = x < 0.7 ? x / 0.7 : 1.0;
+  const double g = x < 0.7 ? 1.0 : std::max(0.0, 1.0 - (x - 0.7) / 0.3);
+  return {(60 + 195 * r) / 255.0, (60 + 160 * g) / 255.0, 60 / 255.0, 1.0};
+}
+
+void FrameStats::Add(double seconds) {
+  seconds_.push_back(seconds);
+  while (seconds_.size() > kKept) seconds_.pop_front();
+}
+
+double FrameStats::MedianFps() const {
+  if (seconds_.empty()) return 0.0;
+  std::vector<double> s(seconds_.begin(), seconds_.end());
+  std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
+  return s[s.size() / 2] > 0.0 ? 1.0 / s[s.size() / 2] : 0.0;
+}
+
+std::vector<double> AppState::KeyframeTimes() const {
+  std::vector<double> times;
+  if (!plan) return times;
+  const bool motion = plan->stats.motion && !plan->trajectories.empty();
+  double k = 0;
+  for (const PlanAction& a : plan->actions) {
+    k += a.approach ? 2 : 1;
+    times.push_back(motion ? a.end_s : k);
+  }
+  return times;
+}
+
+int AppState::ActionAt(double t) const {
+  if (!plan) return -1;
+  const bool motion = plan->stats.motion && !plan->trajectories.empty();
+  const std::vector<double> at = KeyframeTimes();
+  for (size_t i = 0; i < at.size(); ++i) {
+    const double from = motion ? plan->actions[i].start_s : at[i] - 1;
+    if (t >= from && t <= at[i]) return static_cast<int>(i);
+  }
+  return -1;
+}
 
 double AppState::Duration() const {
   if (!plan) return 0.0;
@@ -153,12 +192,7 @@ void PlanPanel::Draw(AppState& app, const PanelRect& r) {
   auto x_of = [&](double time) {
     return origin.x + label_w + static_cast<float>(time / std::max(duration, 1e-9)) * width;
   };
-  std::vector<double> keyframe_time(plan.actions.size());
-  double k = 0;
-  for (size_t i = 0; i < plan.actions.size(); ++i) {
-    k += plan.actions[i].approach ? 2 : 1;
-    keyframe_time[i] = motion ? plan.actions[i].end_s : k;
-  }
+  const std::vector<double> keyframe_time = app.KeyframeTimes();
   for (int rb = 0; rb < n_robots; ++rb) {
     const float y = origin.y + rb * (lane_h + 3);
     dl->AddText(ImVec2(origin.x, y), IM_COL32(200, 200, 200, 255), plan.robots[rb].c_str());
@@ -178,7 +212,7 @@ void PlanPanel::Draw(AppState& app, const PanelRect& r) {
       if (const auto u = a.utilisation.find(rb); u != a.utilisation.end()) {
         dl->AddRectFilled(ImVec2(x_of(start), y + lane_h - 4),
                           ImVec2(std::max(x_of(end), x_of(start) + 2), y + lane_h - 1),
-                          UtilisationColour(u->second));
+                          UtilisationImColour(u->second));
       }
     }
   }
@@ -193,16 +227,12 @@ void PlanPanel::Draw(AppState& app, const PanelRect& r) {
   }
 
   // The wrench utilisation of the action under the cursor, per gripper.
-  int under = -1;
-  for (size_t i = 0; i < plan.actions.size() && under < 0; ++i) {
-    const double from = motion ? plan.actions[i].start_s : keyframe_time[i] - 1;
-    if (pb.t >= from && pb.t <= keyframe_time[i]) under = static_cast<int>(i);
-  }
+  const int under = app.ActionAt(pb.t);
   if (under >= 0 && !plan.actions[under].utilisation.empty()) {
     ImGui::Text("Action %d, wrench utilisation:", under + 1);
     for (const auto& [robot, u] : plan.actions[under].utilisation) {
       ImGui::SameLine();
-      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(UtilisationColour(u)), "%s %.0f%%",
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(UtilisationImColour(u)), "%s %.0f%%",
                          plan.robots[robot].c_str(), 100.0 * u);
     }
   } else if (under >= 0) {

@@ -23,7 +23,8 @@ const std::map<std::string, std::pair<int, int>>& Arity() {
       {"option", {2, 2}},        {"run", {0, 0}},       {"wait", {0, 0}},
       {"expect-plan", {0, 0}},   {"scrub", {1, 1}},     {"play", {0, 0}},
       {"pause", {0, 0}},         {"save", {0, 1}},      {"screenshot", {1, 1}},
-      {"expect-refused", {1, 6}}, {"autosave", {0, 0}},  {"sleep", {1, 1}}};
+      {"expect-refused", {1, 6}}, {"autosave", {0, 0}},  {"sleep", {1, 1}},
+      {"add-urdf", {2, 4}},      {"view", {2, 2}}};
   return arity;
 }
 
@@ -238,6 +239,28 @@ Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const 
     if (!part) return LineError(line, part.error().message);
     app.selection.part = part->name;
     return run(AddPart(*part));
+  }
+  if (cmd == "add-urdf") {
+    if (w.size() == 4) return LineError(line, "add-urdf URDF END_EFFECTOR [ROOT TIP]: both links");
+    auto robot = PrepareUrdfRobot(app.doc.project(), app.doc.ResolvePath(), resolve(w[1]),
+                                  w.size() > 3 ? w[3] : "", w.size() > 4 ? w[4] : "", w[2]);
+    if (!robot) return LineError(line, robot.error().message);
+    app.selection.robot = robot->name;
+    return run(AddRobot(*robot));
+  }
+  if (cmd == "view") {
+    if (w[1] == "utilisation" && (w[2] == "on" || w[2] == "off")) {
+      app.show_utilisation = w[2] == "on";
+    } else if (w[1] == "quality" && w[2] == "auto") {
+      app.quality = QualityMode::kAuto;
+    } else if (w[1] == "quality" && w[2] == "fine") {
+      app.quality = QualityMode::kFine;
+    } else if (w[1] == "quality" && w[2] == "fast") {
+      app.quality = QualityMode::kFast;
+    } else {
+      return LineError(line, "view utilisation on|off, or view quality auto|fine|fast");
+    }
+    return effect;
   }
   if (cmd == "add-step") return run(AddStep(w[1]));
   if (cmd == "delete-step") return run(RemoveStep(w[1]));

@@ -6,6 +6,7 @@
 //   add-step NAME | delete-step NAME | rename OLD NEW
 //   add-edge INPUT STEP | remove-edge INPUT STEP     inputs of a step (cycles are refused)
 //   add-robot MODEL END_EFFECTOR | remove-robot NAME
+//   add-urdf URDF END_EFFECTOR [ROOT TIP]   a robot from a URDF (relative to the script's folder)
 //   set FIELD VALUE...                 a field, e.g. `set part.seat.mass_kg 0.2` (part: mass_kg,
 //                                      density_kg_m3, scale, color, initial_xyz, initial_rpy_deg,
 //                                      assembled_xyz, assembled_rpy_deg; mating: moved, base,
@@ -25,6 +26,8 @@
 //   autosave                           write the recovery file as the interactive window does
 //                                      (off in scripts otherwise, so that they leave none)
 //   sleep SECONDS                      keep drawing frames for that long
+//   view utilisation on|off            grippers tinted by wrench utilisation during playback
+//   view quality auto|fine|fast        the viewport's drawing quality (View menu)
 #pragma once
 
 #include <filesystem>

@@ -65,14 +65,12 @@ Result<std::unique_ptr<Window>> Window::Create(const WindowOptions& options) {
                     (display ? "" : " (DISPLAY is not set: run under X, or xvfb-run)"));
   }
   std::unique_ptr<Window> w(new Window());
-  glfwWindowHint(GLFW_SAMPLES, 4);
+  // Single-sampled: ImGui antialiases its own shapes, and the viewport's cell is drawn in
+  // MuJoCo's offscreen buffer, multisampled only when drawing fine (render/window_renderer.h).
+  // A multisampled window would cost every frame under software GL and could not take the blit.
+  glfwWindowHint(GLFW_SAMPLES, 0);
   w->window_ =
       glfwCreateWindow(options.width, options.height, options.title.c_str(), nullptr, nullptr);
-  if (!w->window_) {
-    glfwWindowHint(GLFW_SAMPLES, 0);
-    w->window_ =
-        glfwCreateWindow(options.width, options.height, options.title.c_str(), nullptr, nullptr);
-  }
   if (!w->window_) {
     return Fail(ErrorCode::kInvalidInput, "cannot create a window with OpenGL: " + glfw_error);
   }

@@ -12,7 +12,8 @@ namespace wrap::render {
 
 namespace {
 constexpr int kExtraGeoms = 64;  // arrows and markers added after mjv_updateScene
-}
+constexpr int kFineSamples = 4;  // multisampling of fine drawing
+}  // namespace
 
 struct ViewportRenderer::Impl {
   ProjectCheck check;
@@ -20,6 +21,7 @@ struct ViewportRenderer::Impl {
   std::unique_ptr<CellModel> model;
   std::unique_ptr<mjData, void (*)(mjData*)> data{nullptr, mj_deleteData};
   std::vector<int> part_body;  // body id per part
+  std::vector<int> body_robot;  // per body: the robot whose end effector it belongs to, or -1
   mjvScene mjscene;
   mjvOption option;
   mjvCamera camera;
@@ -27,8 +29,27 @@ struct ViewportRenderer::Impl {
   bool scene_made = false;
   bool context_made = false;
   int last_w = 1, last_h = 1;
+  // The GL context's offscreen buffer: its size and multisampling.
+  int ctx_w = 0, ctx_h = 0, ctx_samples = -1;
 
   ~Impl() { Free(); }
+  /// (Re)makes MuJoCo's GL context with an offscreen buffer of at least w x h pixels and
+  /// `samples` multisampling. mjr_makeContext reads these from the model's visual settings;
+  /// a shallow copy of the model carries ours (it only reads, and keeps no pointer).
+  void MakeContext(int w, int h, int samples) {
+    if (context_made) mjr_freeContext(&context);
+    context_made = false;
+    mjModel copy = *model->model();
+    copy.vis.global.offwidth = w;
+    copy.vis.global.offheight = h;
+    copy.vis.quality.offsamples = samples;
+    mjr_defaultContext(&context);
+    mjr_makeContext(&copy, &context, mjFONTSCALE_100);
+    context_made = true;
+    ctx_w = w;
+    ctx_h = h;
+    ctx_samples = samples;
+  }
   void Free() {
     if (context_made) mjr_freeContext(&context);
     if (scene_made) mjv_freeScene(&mjscene);
@@ -63,6 +84,21 @@ Result<void> ViewportRenderer::Build(const Project& project, const std::filesyst
   for (const std::string& body : doc->part_bodies) {
     next->part_body.push_back(mj_name2id(m, mjOBJ_BODY, body.c_str()));
   }
+  // The end effector of robot r: the body "robot:NAME/ee" and everything below it (fingers).
+  next->body_robot.assign(m->nbody, -1);
+  for (size_t r = 0; r < next->scene.robots.size(); ++r) {
+    const std::string ee = "robot:" + next->scene.robots[r].name + "/ee";
+    const int root = mj_name2id(m, mjOBJ_BODY, ee.c_str());
+    if (root < 0) continue;
+    for (int b = 1; b < m->nbody; ++b) {
+      for (int a = b; a > 0; a = m->body_parentid[a]) {
+        if (a == root) {
+          next->body_robot[b] = static_cast<int>(r);
+          break;
+        }
+      }
+    }
+  }
   Impl* n = next.get();
   auto made = RunGuarded("making the viewport's GL context", [&] {
     n->data = next->model->MakeData();
@@ -70,9 +106,8 @@ Result<void> ViewportRenderer::Build(const Project& project, const std::filesyst
     mjv_defaultScene(&n->mjscene);
     mjv_makeScene(m, &n->mjscene, m->ngeom + kExtraGeoms);
     n->scene_made = true;
-    mjr_defaultContext(&n->context);
-    mjr_makeContext(m, &n->context, mjFONTSCALE_100);
-    n->context_made = true;
+    n->MakeContext(std::max(640, impl_ ? impl_->ctx_w : 0), std::max(480, impl_ ? impl_->ctx_h : 0),
+                   quality_ == DrawQuality::kFine ? kFineSamples : 0);
     mjr_setBuffer(mjFB_WINDOW, &n->context);
     mjv_defaultFreeCamera(m, &n->camera);
   });
@@ -143,7 +178,30 @@ void ViewportRenderer::Draw(int x, int y, int width, int height) {
   s.last_h = height;
   const mjModel* m = s.model->model();
   (void)RunGuarded("drawing the viewport", [&] {
+    // The offscreen buffer grows (in steps, so a dragged window edge does not remake it every
+    // frame) and its multisampling follows the quality.
+    const bool fine = quality_ == DrawQuality::kFine;
+    const int samples = fine ? kFineSamples : 0;
+    if (width > s.ctx_w || height > s.ctx_h || samples != s.ctx_samples) {
+      auto grow = [](int need, int have) { return need > have ? (need + 255) / 256 * 256 : have; };
+      s.MakeContext(grow(width, s.ctx_w), grow(height, s.ctx_h), samples);
+    }
+    s.mjscene.flags[mjRND_SHADOW] = fine ? 1 : 0;
+    s.mjscene.flags[mjRND_SKYBOX] = fine ? 1 : 0;
+    s.mjscene.flags[mjRND_HAZE] = fine ? 1 : 0;
     mjv_updateScene(m, s.data.get(), &s.option, nullptr, &s.camera, mjCAT_ALL, &s.mjscene);
+    // End effectors tinted (e.g. by their wrench utilisation).
+    for (int g = 0; g < s.mjscene.ngeom && !tints_.empty(); ++g) {
+      mjvGeom& geom = s.mjscene.geoms[g];
+      if (geom.objtype != mjOBJ_GEOM || geom.objid < 0) continue;
+      const int robot = s.body_robot[m->geom_bodyid[geom.objid]];
+      if (robot < 0 || robot >= static_cast<int>(tints_.size()) || !tints_[robot]) continue;
+      const Rgba& tint = *tints_[robot];
+      for (int c = 0; c < 3; ++c) {
+        geom.rgba[c] = static_cast<float>(0.2 * geom.rgba[c] + 0.8 * tint[c]);
+      }
+      geom.emission = 0.4f;
+    }
     // Highlight the selected part: every geom of its body glows.
     if (selected_part_ >= 0 && selected_part_ < static_cast<int>(s.part_body.size())) {
       const int body = s.part_body[selected_part_];
@@ -181,9 +239,12 @@ void ViewportRenderer::Draw(int x, int y, int width, int height) {
       geom->category = mjCAT_DECOR;
       s.mjscene.ngeom++;
     }
+    // Drawn offscreen, then copied into the window's rectangle (resolving the multisampling).
+    mjr_setBuffer(mjFB_OFFSCREEN, &s.context);
+    const mjrRect off{0, 0, width, height};
+    mjr_render(off, &s.mjscene, &s.context);
+    mjr_blitBuffer(off, mjrRect{x, y, width, height}, 1, 0, &s.context);
     mjr_setBuffer(mjFB_WINDOW, &s.context);
-    const mjrRect rect{x, y, width, height};
-    mjr_render(rect, &s.mjscene, &s.context);
   });
 }
 

@@ -33,6 +33,10 @@ struct SceneMarker {
   Rgba color = {0.1, 0.6, 0.9, 0.6};  ///< Colour (translucent).
 };
 
+/// How the viewport draws: antialiased with shadows, or plain (several times faster under
+/// software GL: no multisampling, no shadow pass).
+enum class DrawQuality { kFine, kFast };
+
 /// The cell of the document, compiled and drawn in the viewport.
 class ViewportRenderer {
  public:
@@ -52,8 +56,13 @@ class ViewportRenderer {
 
   /// Shows `state` (robots, fingers, parts) from the next Draw on.
   Result<void> SetState(const SceneState& state);
-  /// Draws into the window rectangle (x, y from the bottom-left, GL convention) [px].
+  /// Draws into the window rectangle (x, y from the bottom-left, GL convention) [px]. The cell
+  /// is drawn into MuJoCo's offscreen buffer (multisampled when fine) and copied to the window,
+  /// whose own framebuffer is single-sampled; the offscreen buffer grows with the viewport.
   void Draw(int x, int y, int width, int height);
+  /// Fine (default) or fast drawing from the next Draw on.
+  void set_quality(DrawQuality quality) { quality_ = quality; }
+  DrawQuality quality() const { return quality_; }
 
   /// Part under the point (rel_x, rel_y) in [0, 1] of the last drawn rectangle (origin
   /// bottom-left), or -1.
@@ -64,6 +73,9 @@ class ViewportRenderer {
   void set_arrows(std::vector<SceneArrow> arrows) { arrows_ = std::move(arrows); }
   /// Discs drawn on the table (placements).
   void set_markers(std::vector<SceneMarker> markers) { markers_ = std::move(markers); }
+  /// Per robot (scene order), a colour the robot's end effector (gripper body, fingers, cup) is
+  /// tinted with, e.g. its wrench utilisation during playback; absent or nullopt: its own colours.
+  void set_gripper_tints(std::vector<std::optional<Rgba>> tints) { tints_ = std::move(tints); }
 
   /// Mouse camera moves, in fractions of the viewport height.
   void Orbit(double dx, double dy);
@@ -80,6 +92,8 @@ class ViewportRenderer {
   int selected_part_ = -1;
   std::vector<SceneArrow> arrows_;
   std::vector<SceneMarker> markers_;
+  std::vector<std::optional<Rgba>> tints_;
+  DrawQuality quality_ = DrawQuality::kFine;
 };
 
 }  // namespace wrap::render
