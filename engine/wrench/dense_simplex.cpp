@@ -27,7 +27,9 @@ namespace wrap {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kPivotTol = 1e-9;  // Tableau entries smaller than this are not pivots.
+// Tableau entries smaller than this are not pivots. 1e-9 let degenerate phase-1 steps pivot on
+// entries of ~3e-8 in redundant rows, and the tableau lost every digit (tests/wrench/data).
+constexpr double kPivotTol = 1e-7;
 constexpr double kOptTol = 1e-9;    // Reduced costs within this of 0 are optimal.
 constexpr double kFeasTol = 1e-9;   // Harris' bound relaxation.
 constexpr int kDegenerateRunForBland = 8;

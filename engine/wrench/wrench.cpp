@@ -84,6 +84,29 @@ struct WrenchChecker::Impl {
   std::unordered_map<std::uint64_t, WrenchCheck> by_key;
   std::uint64_t hits = 0;
   std::uint64_t misses = 0;
+  std::unique_ptr<LpBackend> reference;  // Clp, made when the dense simplex first gives no answer
+  std::uint64_t fallbacks = 0;
+
+  // The backend's answer, or Clp's when the dense simplex ends without one (infeasible, an
+  // iteration limit, an error) on an LP that has an answer by construction (x = 0, s = 0 is
+  // feasible; the joint LP is feasible once the holding LP passed): a numerical failure of ours,
+  // not of the configuration. `full` is the problem with its varying column in place.
+  LpStatus SolveVarying(const LpProblem& full, const double* values) {
+    const LpStatus status = lp->SolveWithColumn(values, solution);
+    return status == LpStatus::kOptimal || status == LpStatus::kUnbounded ? status
+                                                                         : SolveReference(full);
+  }
+  LpStatus SolveFull(const LpProblem& full) {
+    const LpStatus status = lp->Solve(full, solution);
+    return status == LpStatus::kOptimal || status == LpStatus::kUnbounded ? status
+                                                                         : SolveReference(full);
+  }
+  LpStatus SolveReference(const LpProblem& full) {
+    if (options.backend == WrenchLpBackend::kClp) return solution.status;
+    if (!reference) reference = MakeClpBackend();
+    ++fallbacks;
+    return reference->Solve(full, solution);
+  }
 
   Result<WrenchCheck> Compute(const StepConfiguration& config, const WrenchQuery& query);
   // The variant of `problem` with s = 1 and every finite bound at 0 (the load factor was
@@ -302,7 +325,7 @@ Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config
   for (int v = 0; v < vertices.count; ++v) {
     const double* w = vertices.vertex(v);
     std::copy(w, w + rows, problem.column(n));  // The zero-utilisation variant starts from it.
-    LpStatus status = lp->SolveWithColumn(w, solution);
+    LpStatus status = SolveVarying(problem, w);
     double utilisation = 0.0;
     bool failing = false;
     if (status == LpStatus::kOptimal) {
@@ -336,7 +359,7 @@ Result<void> WrenchChecker::Impl::SolveAtZeroUtilisation(int n) {
     if (std::isfinite(zero_problem.lower[j])) zero_problem.lower[j] = 0.0;
     if (std::isfinite(zero_problem.upper[j])) zero_problem.upper[j] = 0.0;
   }
-  const LpStatus status = lp->Solve(zero_problem, solution);
+  const LpStatus status = SolveFull(zero_problem);
   if (status != LpStatus::kOptimal) {
     return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
                                           "' found the load factor unbounded but no " +
@@ -366,7 +389,7 @@ Result<WrenchCheck> WrenchChecker::Impl::ComputeHeldThenMated(const StepConfigur
   {
     std::copy(w_grav, w_grav + nb6, problem.column(n));
     lp->LoadBase(problem, n);
-    const LpStatus status = lp->SolveWithColumn(w_grav, solution);
+    const LpStatus status = SolveVarying(problem, w_grav);
     if (status == LpStatus::kOptimal) {
       const double s = solution.x[n] > kTinyLoadFactor ? solution.x[n] : 0.0;
       hold_utilisation = s > 0.0 ? 1.0 / s : kInf;
@@ -439,7 +462,7 @@ Result<WrenchCheck> WrenchChecker::Impl::ComputeHeldThenMated(const StepConfigur
     std::copy(w, w + nb6, joint.column(s_col) + nb6);
     std::fill(joint.column(s_col), joint.column(s_col) + nb6, 0.0);
     for (int k = 0; k < nv; ++k) joint.column(s_col)[2 * nb6 + k] = 0.0;
-    LpStatus status = lp->SolveWithColumn(joint.column(s_col), solution);
+    LpStatus status = SolveVarying(joint, joint.column(s_col));
     double s = kInf;
     if (status == LpStatus::kOptimal) {
       s = solution.x[s_col] > kTinyLoadFactor ? solution.x[s_col] : 0.0;
@@ -448,7 +471,7 @@ Result<WrenchCheck> WrenchChecker::Impl::ComputeHeldThenMated(const StepConfigur
       LpProblem at_one = joint;
       at_one.cost[s_col] = 0.0;
       at_one.lower[s_col] = at_one.upper[s_col] = 1.0;
-      status = lp->Solve(at_one, solution);
+      status = SolveFull(at_one);
       if (status != LpStatus::kOptimal) {
         return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
                                               "' found the mating load factor unbounded but no " +
@@ -556,6 +579,7 @@ Result<WrenchCheck> WrenchChecker::CheckCached(std::uint64_t key, const StepConf
 
 std::uint64_t WrenchChecker::cache_hits() const { return impl_->hits; }
 std::uint64_t WrenchChecker::cache_misses() const { return impl_->misses; }
+std::uint64_t WrenchChecker::lp_fallbacks() const { return impl_->fallbacks; }
 
 void WrenchChecker::ClearCache() {
   impl_->by_hash.clear();

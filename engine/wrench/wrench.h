@@ -265,6 +265,9 @@ class WrenchChecker {
   std::uint64_t cache_hits() const;
   /// Cache misses (answers computed) since construction or the last ClearCache().
   std::uint64_t cache_misses() const;
+  /// LPs the dense simplex ended without an answer that has one by construction (a numerical
+  /// failure), answered by Clp instead. 0 with the Clp backend.
+  std::uint64_t lp_fallbacks() const;
   /// Forgets every cached answer.
   void ClearCache();
   /// The options.

@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
 #include <limits>
 #include <random>
 
@@ -135,6 +139,63 @@ TEST(DenseSimplex, EdgeCases) {
   EXPECT_EQ(dense->Solve(p, s), LpStatus::kInfeasible);
   p.rhs.push_back(1.0);  // Inconsistent sizes.
   EXPECT_EQ(dense->Solve(p, s), LpStatus::kError);
+}
+
+/// Reads an LP written as in tests/wrench/data ('#' comment lines, then rows cols, A
+/// column-major, rhs, cost, lower, upper; "inf" allowed).
+LpProblem ReadLp(const std::string& file) {
+  std::ifstream in(file);
+  std::string line, text;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line[0] != '#') text += line + "\n";
+  }
+  std::istringstream words(text);
+  int m = -1, n = -1;
+  words >> m >> n;
+  LpProblem p;
+  if (m < 0 || n < 0) return p;
+  p.Reset(m, n);
+  auto read = [&](std::vector<double>& v) {
+    for (double& x : v) {
+      std::string w;
+      words >> w;
+      x = std::strtod(w.c_str(), nullptr);
+    }
+  };
+  read(p.a);
+  read(p.rhs);
+  read(p.cost);
+  read(p.lower);
+  read(p.upper);
+  return p;
+}
+
+// A mating LP of the stool that the dense simplex once called infeasible (degenerate phase-1
+// pivots on tiny entries): it must find Clp's optimum, from a cold start and through the varying
+// column, and at other scales.
+TEST(DenseSimplex, SolvesTheStoolMatingLpThatOnceFailed) {
+  const LpProblem p = ReadLp(std::string(WRAP_SOURCE_DIR) +
+                             "/tests/wrench/data/stool_seed2_mating_lp.txt");
+  ASSERT_EQ(p.rows, 30);
+  ASSERT_EQ(p.cols, 43);
+  std::unique_ptr<LpBackend> dense = MakeDenseSimplexBackend();
+  std::unique_ptr<LpBackend> clp = MakeClpBackend();
+  for (double scale : {1.0, 0.5, 2.0, 10.0}) {
+    LpProblem q = p;
+    for (double& r : q.rhs) r *= scale;
+    for (double& l : q.lower) l *= scale;
+    for (double& u : q.upper) u *= scale;
+    LpSolution a, b;
+    ASSERT_EQ(clp->Solve(q, b), LpStatus::kOptimal);
+    ASSERT_EQ(dense->Solve(q, a), LpStatus::kOptimal) << "scale " << scale;
+    EXPECT_NEAR(a.objective, b.objective, 1e-6 * (1.0 + std::abs(b.objective))) << scale;
+    EXPECT_LT(Violation(q, a.x), 1e-7) << "scale " << scale;
+  }
+  EXPECT_NEAR([&] {
+    LpSolution b;
+    clp->Solve(p, b);
+    return b.objective;
+  }(), -3.9607, 1e-3) << "the load factor s = 3.96";
 }
 
 // The wrench LP's shape: A x + s w = 0, bounds containing 0, maximise s (the last column), solved
