@@ -156,6 +156,13 @@ class Builder {
       const std::vector<JointVector>& goal_q, const Keyframe& target,
       std::vector<std::pair<size_t, JointVector>>& rebranch, double* length, std::string& why);
   bool Action(int index);
+  // The start of an insertion's slide. The task planner lets the moved input touch the base at
+  // the approach keyframe (faces that slide along each other, as in a stack of cubes), but a
+  // free path or a carry cannot end in that contact. When the moved input touches the base
+  // there (and nothing else is hit), the start moves back along the insertion line, 1 to 6 cm,
+  // until the input is clear: `goal` (the approach keyframe) gets the holders' joints and the
+  // input's pose there, and the insertion skill slides from it. Otherwise `goal` stays.
+  void SlideStart(int action, Keyframe& goal);
   bool Return(int action, int robot, const JointVector& goal, bool main);
   // Robot r at `q` instead of its joints at the keyframe `kf` (same TCP): collision-free and
   // clear of the other robots there (objects at the keyframe's poses, `mating` allowed).
@@ -1012,6 +1019,50 @@ bool Builder::KeyframeAccepts(int robot, const JointVector& q, const Keyframe& k
   return scene_.cell().MinRobotClearance(request).distance >= kMinClearance;
 }
 
+void Builder::SlideStart(int action, Keyframe& goal) {
+  const PlanAction& a = plan_.actions[action];
+  if (a.type != ActionType::kAssemble || !a.approach || a.objects.size() < 2) return;
+  const int m_node = a.objects[0], b_node = a.objects[1];
+  const std::vector<int> holders = state_.Holders(m_node);
+  if (holders.empty()) return;
+  const int h0 = holders[0];
+  if (KeyframeAccepts(h0, goal.q[h0], goal, {})) return;                  // clear already
+  if (!KeyframeAccepts(h0, goal.q[h0], goal, {{m_node, b_node}})) return;  // not that contact
+  Vec3 u = Tcp(h0, goal.q[h0]).translation() - Tcp(h0, a.keyframe.q[h0]).translation();
+  if (u.norm() < 1e-6) return;
+  u.normalize();
+  std::vector<JointVector> q0;
+  for (int r : holders) q0.push_back(goal.q[r]);
+  for (double extra : {0.01, 0.02, 0.04, 0.06}) {
+    std::vector<std::function<Iso3(double)>> targets;
+    for (int r : holders) {
+      const Iso3 Xa = Tcp(r, goal.q[r]);
+      targets.push_back([Xa, u, extra](double s) {
+        Iso3 X = Xa;
+        X.translation() += s * extra * u;
+        return X;
+      });
+    }
+    const int steps = std::max(2, static_cast<int>(std::ceil(extra / opt_.cartesian_step_m)));
+    const auto path = Track(holders, q0, targets, steps);
+    if (path.empty()) continue;
+    Keyframe pre = goal;
+    for (size_t k = 0; k < holders.size(); ++k) pre.q[holders[k]] = path.back()[k];
+    for (PlanObject& o : pre.objects) {
+      if (o.node == m_node) o.X_WA.translation() += extra * u;
+    }
+    if (KeyframeAccepts(h0, pre.q[h0], pre, {})) {
+      if (std::getenv("WRAP_MOTION_DEBUG")) {
+        std::fprintf(stderr, "[slide] action %d: %s touches %s at the approach; the slide starts "
+                     "%.0f mm further back\n", action + 1, NodeName(m_node).c_str(),
+                     NodeName(b_node).c_str(), 1000.0 * extra);
+      }
+      goal = std::move(pre);
+      return;
+    }
+  }
+}
+
 bool Builder::StageAccepts(int robot, int action, bool from_approach, const JointVector& old_q,
                            const JointVector& new_q) {
   const PlanState saved = state_;
@@ -1082,7 +1133,10 @@ bool Builder::Action(int i) {
     new_grasp = a.grasps[1].grasp;
   }
   const bool assemble = a.type == ActionType::kAssemble;
-  const Keyframe& target_kf = assemble && a.approach ? *a.approach : K;
+  // Where the movers go before the final skill: the approach keyframe of an insertion (or the
+  // start of its slide), else the keyframe.
+  Keyframe target_kf = assemble && a.approach ? *a.approach : K;
+  if (assemble && a.approach) SlideStart(i, target_kf);
   struct Moving {
     int node;
     std::vector<int> holders;
