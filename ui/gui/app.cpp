@@ -8,6 +8,7 @@
 #include <fstream>
 #include <ostream>
 #include <sstream>
+#include <thread>
 
 #include "core/file_io.h"
 #include "gui/commands.h"
@@ -165,6 +166,34 @@ class App {
     }
     s_.viewport.set_quality(fine ? DrawQuality::kFine : DrawQuality::kFast);
     last_frame_fine_ = fine;
+  }
+
+  /// The interactive loop's pacing, so that the window leaves the CPU to the planner: while
+  /// nothing changes (no run, no playback, no drag, no edit waiting for the recovery file) it
+  /// sleeps until the next input, after drawing a few frames past the last one (ImGui settles
+  /// hover and focus); while something moves it draws at most 30 frames per second.
+  void Pace() {
+    const bool moving = s_.job.running() || s_.playback.playing || ImGui::IsAnyItemActive() ||
+                        (autosave_ && s_.doc.revision() != autosave_revision_) ||
+                        (autosave_ && win_.time() - last_edit_ < kAutosaveQuietS + 0.1);
+    if (moving) {
+      settle_frames_ = 0;
+      const double left = 1.0 / 30.0 - (win_.time() - last_time_);
+      if (left > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(left));
+      return;
+    }
+    // Input (or a resize) in this frame: a few more frames before sleeping.
+    const ImGuiIO& io = ImGui::GetIO();
+    bool input = io.MouseDelta.x != 0.0f || io.MouseDelta.y != 0.0f || io.MouseWheel != 0.0f ||
+                 io.MouseWheelH != 0.0f || io.InputQueueCharacters.Size > 0 ||
+                 ImGui::IsAnyMouseDown() || io.DisplaySize.x != last_size_.x ||
+                 io.DisplaySize.y != last_size_.y;
+    for (bool down : io.KeysDown) input = input || down;
+    last_size_ = io.DisplaySize;
+    if (input) settle_frames_ = 0;
+    if (++settle_frames_ < 3) return;
+    win_.WaitEvents(2.0);  // and at least every 2 s
+    last_time_ = win_.time();  // a wait is not a slow frame
   }
 
   bool quit() const { return quit_; }
@@ -625,6 +654,8 @@ class App {
   bool quit_ = false;
   double last_time_ = 0.0, last_autosave_ = 0.0, last_edit_ = 0.0;
   double fine_frame_s_ = 0.0;  // how long the last frame drawn fine took
+  int settle_frames_ = 0;      // frames drawn since the last input while nothing moves
+  ImVec2 last_size_{0.0f, 0.0f};
   bool last_frame_fine_ = true;
   bool autosave_ = false;
   unsigned long autosave_revision_ = 0;
@@ -760,6 +791,7 @@ int RunGui(const GuiOptions& options, std::ostream& out, std::ostream& err) {
   while (!app.quit()) {
     app.Frame(nullptr);
     app.HandleCloseRequest();
+    app.Pace();
   }
   s.job.Cancel();
   return 0;

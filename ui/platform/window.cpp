@@ -5,6 +5,7 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <mutex>
 #include <utility>
@@ -149,6 +150,8 @@ void Window::EndFrame(const std::function<void()>& draw_scene, render::Image* ca
   }
   glfwSwapBuffers(window_);
 }
+
+void Window::WaitEvents(double timeout_s) { glfwWaitEventsTimeout(std::max(0.0, timeout_s)); }
 
 bool Window::close_requested() const { return glfwWindowShouldClose(window_) != 0; }
 

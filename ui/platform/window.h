@@ -53,6 +53,9 @@ class Window {
   std::vector<std::string> TakeDroppedFiles();
   /// Seconds since the window opened.
   double time() const;
+  /// Sleeps until an input event arrives (mouse, keys, resize, a dropped file) or `timeout_s`
+  /// passes: the interactive loop's pause while nothing on screen changes.
+  void WaitEvents(double timeout_s);
 
  private:
   Window() = default;
