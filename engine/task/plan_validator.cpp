@@ -4,6 +4,7 @@
 // not repeated here. See plan_validator.h for what is checked and task/plan.h for the contract.
 #include "task/plan_validator.h"
 
+#include "core/frames.h"
 #include "robot/project_chain.h"
 
 #include <algorithm>
@@ -78,18 +79,6 @@ PoseError Difference(const Iso3& a, const Iso3& b) {
   const Mat3 R = a.linear().transpose() * b.linear();
   e.rotation_rad = std::acos(std::clamp(0.5 * (R.trace() - 1.0), -1.0, 1.0));
   return e;
-}
-
-// A rotation whose z axis is `axis` (unit).
-Mat3 FrameWithZ(const Vec3& axis) {
-  const Vec3 z = axis.normalized();
-  const Vec3 helper = std::abs(z.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  const Vec3 x = (helper - helper.dot(z) * z).normalized();
-  Mat3 R;
-  R.col(0) = x;
-  R.col(1) = z.cross(x);
-  R.col(2) = z;
-  return R;
 }
 
 // The part of the convex counter-clockwise polygon `poly` inside the rectangle [lo, hi]
@@ -314,7 +303,7 @@ Result<void> Validator::Setup(const std::filesystem::path& project_file) {
     }
     const Vec3 axis = f.step->mating.axis;
     f.axis_A = axis.norm() > 0.0 ? axis.normalized() : Vec3::UnitZ();
-    f.X_AC.linear() = FrameWithZ(f.axis_A);
+    f.X_AC.linear() = RotationWithZ(f.axis_A);
     f.X_AC.translation() = f.p_A;
     f.limits = BoundsFromBox(f.step->mating.connection_limits.value_or(project_.connection_limits));
   }

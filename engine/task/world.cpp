@@ -5,6 +5,7 @@
 #include <limits>
 #include <random>
 
+#include "core/frames.h"
 #include "robot/home.h"
 #include "robot/project_chain.h"
 #include "robot/kinematics.h"
@@ -43,18 +44,6 @@ double BoxOverlap(const Aabb& a, const Aabb& b, double grow, Vec3* centre) {
   if (d.minCoeff() <= 0.0) return -1.0;
   if (centre) *centre = 0.5 * (lo + hi);
   return d.x() * d.y() * d.z();
-}
-
-Iso3 FrameWithZ(const Vec3& origin, const Vec3& z_axis) {
-  const Vec3 z = z_axis.normalized();
-  const Vec3 helper = std::abs(z.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  const Vec3 x = (helper - helper.dot(z) * z).normalized();
-  Iso3 X = Iso3::Identity();
-  X.linear().col(0) = x;
-  X.linear().col(1) = z.cross(x);
-  X.linear().col(2) = z;
-  X.translation() = origin;
-  return X;
 }
 
 void CollectSteps(const AssemblyTree& tree, int node, std::vector<int>& out) {
@@ -238,7 +227,9 @@ Result<TaskWorld> BuildTaskWorld(const Project& project, const ProjectCheck& che
         }
       }
     }
-    s.X_AC = FrameWithZ(s.p_A, s.axis_A);
+    s.X_AC = Iso3::Identity();
+    s.X_AC.linear() = RotationWithZ(s.axis_A);
+    s.X_AC.translation() = s.p_A;
     s.connection =
         BoundsFromBox(step.mating.connection_limits.value_or(project.connection_limits));
   }

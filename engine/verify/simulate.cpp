@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 
+#include "core/frames.h"
 #include "robot/kinematics.h"
 #include "sim/mjcf.h"
 #include "sim/mujoco_model.h"
@@ -43,19 +44,6 @@ struct Interface {
   double torque_Nm = 0.0;
   WrenchBox limits;  // T_pq of the connection, in its frame C
 };
-
-// The connection frame C in A: origin at the interface, z along the axis (as task/world.cpp).
-Iso3 ConnectionFrame(const Vec3& origin, const Vec3& z_axis) {
-  const Vec3 z = z_axis.normalized();
-  const Vec3 helper = std::abs(z.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  const Vec3 x = (helper - helper.dot(z) * z).normalized();
-  Iso3 X = Iso3::Identity();
-  X.linear().col(0) = x;
-  X.linear().col(1) = z.cross(x);
-  X.linear().col(2) = z;
-  X.translation() = origin;
-  return X;
-}
 
 Aabb PartBoxInA(const ScenePart& part) {
   Aabb box;
@@ -701,7 +689,10 @@ class Simulator {
       Vec3 f_W, tau_W;
       WeldWrench(j.eq, j.part, f_W, tau_W);
       const Iso3 X_WA = PartPose(in.part_base) * scene_.parts[in.part_base].X_AP.inverse();
-      const Iso3 X_WC = X_WA * ConnectionFrame(in.p_A, in.axis_A);
+      Iso3 X_AC = Iso3::Identity();  // the connection frame C in A (core/pose.h)
+      X_AC.linear() = RotationWithZ(in.axis_A);
+      X_AC.translation() = in.p_A;
+      const Iso3 X_WC = X_WA * X_AC;
       tau_W += (PartPose(j.part).translation() - X_WC.translation()).cross(f_W);
       const double u =
           BoxUtilisation(X_WC.linear().transpose() * f_W, X_WC.linear().transpose() * tau_W,
