@@ -19,8 +19,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
+#include <mutex>
 #include <source_location>
 #include <sstream>
+#include <unordered_map>
 #include <utility>
 
 namespace wrap {
@@ -37,6 +40,64 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 inline void Check(bool ok, const char* what,
                   const std::source_location& loc = std::source_location::current()) {
   if (!ok) Fatal(what, loc);
+}
+
+// The FCL trees of meshes, shared by every world that adds the same mesh: cells are built per
+// task plan, per set of finger openings and per check, and building the tree of a Fabrica part
+// costs milliseconds. An entry lives while some world uses its tree; the mesh is compared
+// exactly, not by its hash alone.
+class MeshTreeCache {
+ public:
+  using Tree = fcl::BVHModel<fcl::OBBRSSd>;
+  /// The tree of (vertices, triangles), built when no world holds one; null when FCL fails.
+  std::shared_ptr<const Tree> Get(const std::vector<fcl::Vector3d>& vertices,
+                                  const std::vector<fcl::Triangle>& triangles) {
+    std::uint64_t h = 1469598103934665603ULL;
+    auto mix = [&h](const void* data, std::size_t bytes) {
+      const auto* p = static_cast<const unsigned char*>(data);
+      for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ULL;
+    };
+    for (const fcl::Vector3d& v : vertices) mix(v.data(), 3 * sizeof(double));
+    for (const fcl::Triangle& t : triangles) {
+      const std::size_t idx[3] = {t[0], t[1], t[2]};
+      mix(idx, sizeof idx);
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<Entry>& bucket = entries_[h];
+    std::erase_if(bucket, [](const Entry& e) { return e.tree.expired(); });
+    for (const Entry& e : bucket) {
+      if (e.vertices == vertices && e.triangles.size() == triangles.size() &&
+          std::equal(e.triangles.begin(), e.triangles.end(), triangles.begin(),
+                     [](const fcl::Triangle& a, const fcl::Triangle& b) {
+                       return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+                     })) {
+        if (auto tree = e.tree.lock()) return tree;
+      }
+    }
+    auto model = std::make_shared<Tree>();
+    if (model->beginModel(static_cast<int>(triangles.size()), static_cast<int>(vertices.size())) !=
+            fcl::BVH_OK ||
+        model->addSubModel(vertices, triangles) != fcl::BVH_OK || model->endModel() != fcl::BVH_OK) {
+      return nullptr;
+    }
+    model->computeLocalAABB();
+    bucket.push_back({model, vertices, triangles});
+    return model;
+  }
+
+ private:
+  struct Entry {
+    std::weak_ptr<const Tree> tree;
+    std::vector<fcl::Vector3d> vertices;
+    std::vector<fcl::Triangle> triangles;
+  };
+  std::mutex mutex_;
+  std::unordered_map<std::uint64_t, std::vector<Entry>> entries_;
+};
+
+MeshTreeCache& MeshTrees() {
+  static MeshTreeCache cache;
+  return cache;
 }
 
 // How a shape takes part in the narrowphase: a swept sphere (sphere or capsule: closed forms), a
@@ -77,6 +138,7 @@ struct BodyData {
   int group = 0;
   bool enabled = true;
   bool dirty = true;
+  std::uint64_t changed_at = 0;  // Impl::epoch when the pose last changed (see Impl::clean)
   Iso3 X_WB = Iso3::Identity();
   int first = 0;  // first shape in Impl::shapes
   int count = 0;  // number of shapes
@@ -211,6 +273,11 @@ struct CollisionWorld::Impl {
   std::vector<BodyData> bodies;
   std::vector<ShapeData> shapes;
   std::vector<std::uint8_t> allowed;  // num_bodies^2, symmetric
+  // Pairs found apart by their last exact (margin 0) test: epoch + 1 at that test. A pair is
+  // not tested again until one of its bodies moves (resting parts close to each other would
+  // otherwise be tested tree against tree at every query). num_bodies^2, index a * n + b, a < b.
+  std::vector<std::uint64_t> clean;
+  std::uint64_t epoch = 1;  // counts pose changes
   GroupPairSet allowed_groups;
   bool any_dirty = true;
 
@@ -535,6 +602,7 @@ struct CollisionWorld::Impl {
       order[m] = v;
     }
     const double margin = request.margin_m;
+    if (clean.size() != bodies.size() * bodies.size()) clean.assign(bodies.size() * bodies.size(), 0);
     bool hit = false;
     for (std::size_t ii = 0; ii < order.size(); ++ii) {
       const int i = order[ii];
@@ -550,7 +618,18 @@ struct CollisionWorld::Impl {
         if (Allowed(i, j)) continue;
         const int a = std::min(i, j);
         const int b = std::max(i, j);
-        if (BodyPairCollide(a, b, request, result, &hit)) return true;
+        const std::size_t pair = static_cast<std::size_t>(a) * bodies.size() + b;
+        if (margin == 0.0 && clean[pair] > std::max(bodies[a].changed_at, bodies[b].changed_at)) {
+          continue;
+        }
+        bool pair_hit = false;
+        const bool done = BodyPairCollide(a, b, request, result, &pair_hit);
+        if (pair_hit) {
+          hit = true;
+        } else if (margin == 0.0) {
+          clean[pair] = epoch + 1;
+        }
+        if (done) return true;
       }
     }
     return hit;
@@ -732,10 +811,8 @@ Result<BodyId> CollisionWorld::AddBody(const BodyDef& def) {
         for (const Vec3& v : mesh.vertices) {
           if (!AllFinite(v)) return Fail(ErrorCode::kInvalidInput, at + ": a vertex is not finite");
         }
-        auto model = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
-        if (model->beginModel(static_cast<int>(triangles.size()), nv) != fcl::BVH_OK ||
-            model->addSubModel(vertices, triangles) != fcl::BVH_OK ||
-            model->endModel() != fcl::BVH_OK) {
+        auto model = MeshTrees().Get(vertices, triangles);
+        if (!model) {
           return Fail(ErrorCode::kInvalidInput, at + ": FCL could not build the mesh's tree");
         }
         const Aabb box = ComputeAabb(mesh);
@@ -747,7 +824,10 @@ Result<BodyId> CollisionWorld::AddBody(const BodyDef& def) {
         break;
       }
     }
-    std::const_pointer_cast<fcl::CollisionGeometryd>(s.geom)->computeLocalAABB();
+    // (Mesh trees come from the shared cache with their boxes computed.)
+    if (s.kind != Kind::kMesh) {
+      std::const_pointer_cast<fcl::CollisionGeometryd>(s.geom)->computeLocalAABB();
+    }
     added.push_back(std::move(s));
   }
 
@@ -798,8 +878,10 @@ BodyId CollisionWorld::FindBody(const std::string& name) const {
 
 void CollisionWorld::SetPose(BodyId body, const Iso3& X_WB) {
   BodyData& b = impl_->body(body);
+  if (b.X_WB.matrix() == X_WB.matrix()) return;
   b.X_WB = X_WB;
   b.dirty = true;
+  b.changed_at = ++impl_->epoch;
   impl_->any_dirty = true;
 }
 
@@ -808,8 +890,11 @@ const Iso3& CollisionWorld::pose(BodyId body) const { return impl_->body(body).X
 void CollisionWorld::SetPoses(std::span<const Iso3> X_WB) {
   Check(static_cast<int>(X_WB.size()) == impl_->n(), "SetPoses: one pose per body expected");
   for (int i = 0; i < impl_->n(); ++i) {
-    impl_->bodies[i].X_WB = X_WB[i];
-    impl_->bodies[i].dirty = true;
+    BodyData& b = impl_->bodies[i];
+    if (b.X_WB.matrix() == X_WB[i].matrix()) continue;
+    b.X_WB = X_WB[i];
+    b.dirty = true;
+    b.changed_at = ++impl_->epoch;
   }
   impl_->any_dirty = true;
 }
