@@ -38,6 +38,14 @@ constexpr int kNumericRestarts[] = {3, 10, 25};
 constexpr int kMaxLeaves = 24;  // IK combinations tried per pose candidate
 constexpr int kMaxSolutionsPerRobot = 8;
 constexpr double kTouchTolerance = 2e-3;  // an object this close above the table rests on it
+// The straight moves that the motion stage makes at a keyframe as skills (a gripper's approach
+// to its grasp along its axis, a placement's descent) must be clear for at least this length
+// [m], checked at kStraightSamples points.
+constexpr double kStraightM = 0.02;
+// A retreat needs less: a release is permanent (nothing to sample), and a gripper near the table
+// still backs off a centimetre where two would hit it.
+constexpr double kRetreatM = 0.01;
+constexpr int kStraightSamples = 4;
 
 }  // namespace
 
@@ -438,6 +446,64 @@ void KeyframeSolver::SetScene(const std::vector<PlanObject>& objects,
   for (int r = 0; r < static_cast<int>(world_.robots.size()); ++r) {
     if (fingers_[r]) PlaceFingers(r, cell_.X_WF(r));
   }
+}
+
+bool KeyframeSolver::StraightClear(int robot, const JointVector& q, const Vec3& dir_W,
+                                   double length_m, std::string* why) {
+  const TaskRobot& r = world_.robots[robot];
+  const Iso3 X0 = TcpPose(r.chain, r.X_WB, q, r.end_effector.X_FT);
+  const int branch = r.ur ? r.ur->BranchOf(r.chain, q) : -1;
+  JointVector prev = q;
+  bool ok = true;
+  for (int k = 1; k <= kStraightSamples && ok; ++k) {
+    Iso3 X = X0;
+    X.translation() += (length_m * k / kStraightSamples) * dir_W;
+    const Iso3 X_BT = r.X_BW * X;
+    JointVector next;
+    ++counters_.ik_calls;
+    if (r.ur) {
+      UrIkOptions options;
+      options.q6_if_singular = prev[5];
+      const UrIkSolutions sols = r.ur->SolveTcp(X_BT, r.end_effector.X_FT, options);
+      for (int c = 0; c < sols.count; ++c) {
+        if (sols.branch[c] == branch) next = NearestEquivalent(r.chain, sols.q[c], prev);
+      }
+    } else {
+      NumericIkRequest request;
+      request.X_BT = X_BT;
+      request.X_FT = r.end_effector.X_FT;
+      request.seeds = {prev};
+      request.reference = prev;
+      NumericIkOptions o;
+      o.restarts = 0;
+      o.position_tolerance_m = 5e-4;
+      o.rotation_tolerance_rad = 5e-3;
+      std::mt19937_64 rng(static_cast<std::uint64_t>(k));
+      auto result = SolveNumericIk(r.chain, request, rng, o);
+      if (result) next = result->q;
+    }
+    // The motion stage tracks the line on this branch with steps of at most 0.25 rad.
+    if (next.size() == 0 || (next - prev).cwiseAbs().maxCoeff() > 0.25) {
+      if (why) *why = "no IK solution along the line";
+      ok = false;
+      break;
+    }
+    SetRobot(robot, next);
+    if (Collides()) {
+      if (why) {
+        CollisionResult hit;
+        cell_.InCollision(&hit);
+        const CollisionWorld& w = cell_.world();
+        *why = hit.collision ? "'" + w.body_name(hit.first.body_a) + "' hits '" +
+                                   w.body_name(hit.first.body_b) + "'"
+                             : "a collision";
+      }
+      ok = false;
+    }
+    prev = next;
+  }
+  SetRobot(robot, q);
+  return ok;
 }
 
 bool KeyframeSolver::Search(const std::vector<Mover>& movers,
@@ -845,6 +911,57 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
           leaf_message = "robots closer than " +
                          std::to_string(options_.min_clearance_m * 1000).substr(0, 4) + " mm";
           return false;
+        }
+      }
+      {
+        // The skills at this keyframe: each new grasp's straight approach along the gripper
+        // axis, each freed gripper's retreat, a placement's descent (motion makes them straight;
+        // a keyframe that leaves no room for them has no motion).
+        std::string why_straight;
+        for (size_t i = 0; i < movers.size(); ++i) {
+          const int r = movers[i].robot;
+          const bool grasps = (r == a.r1 && (a.type == ActionType::kPick ||
+                                             a.type == ActionType::kAddGrasp)) ||
+                              (r == a.r2 && a.type == ActionType::kHandover);
+          if (!grasps) continue;
+          const TaskRobot& R = world_.robots[r];
+          const Vec3 back = -TcpPose(R.chain, R.X_WB, q[i], R.end_effector.X_FT).linear().col(2);
+          if (!StraightClear(r, q[i], back, kStraightM, &why_straight)) {
+            search_gate = Gate::kApproach;
+            leaf_message = "'" + R.name + "' cannot approach its grasp straight along the " +
+                           "gripper axis: " + why_straight;
+            return false;
+          }
+        }
+        for (int r : freed) {
+          JointVector qr = c.q[r];
+          for (size_t i = 0; i < movers.size(); ++i) {
+            if (movers[i].robot == r) qr = q[i];
+          }
+          const TaskRobot& R = world_.robots[r];
+          const Iso3 X_WT = TcpPose(R.chain, R.X_WB, qr, R.end_effector.X_FT);
+          if (a.type == ActionType::kPlace) {
+            // The descent onto the table, seen from the bottom: the object rides along.
+            const auto& parts = world_.tree->nodes[o].parts;
+            for (int p : parts) cell_.Attach(p, r);
+            const bool down = StraightClear(r, qr, Vec3::UnitZ(), kStraightM, &why_straight);
+            for (int p : parts) {
+              cell_.Detach(p, r);
+              cell_.world().SetAllowed(cell_.object_body(p), cell_.end_effector_body(r), true);
+            }
+            if (!down) {
+              search_gate = Gate::kApproach;
+              leaf_message =
+                  "'" + R.name + "' cannot set its object down straight: " + why_straight;
+              return false;
+            }
+          }
+          if (!StraightClear(r, qr, -X_WT.linear().col(2), kRetreatM, &why_straight)) {
+            search_gate = Gate::kApproach;
+            leaf_message = "'" + R.name + "' cannot back its gripper away straight after " +
+                           "letting go: " + why_straight;
+            return false;
+          }
         }
       }
       if (!freed.empty()) {

@@ -123,6 +123,12 @@ class KeyframeSolver {
   void SetRobot(int robot, const JointVector& q);
   void EnableRobot(int robot, bool on);
   bool Collides();
+  /// Robot `robot` from `q` moves its TCP straight by `length_m` along `dir_W` (the other robots
+  /// and the objects as set) without hitting anything, checked at a few points on its IK branch:
+  /// the straight approach to a grasp, the retreat from a release, the descent of a placement,
+  /// which the motion stage makes as skills. Restores `q`. False with the reason in `why`.
+  bool StraightClear(int robot, const JointVector& q, const Vec3& dir_W, double length_m,
+                     std::string* why);
   bool Search(const std::vector<Mover>& movers, const std::vector<std::vector<JointVector>>& sols,
               size_t depth, std::vector<JointVector>& chosen, int& leaves, Gate& gate,
               const std::function<bool(std::vector<JointVector>&)>& leaf);
