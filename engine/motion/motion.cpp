@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
 
 #include "motion/retime.h"
 #include "motion/trajectory_check.h"
+#include "task/plan_json.h"
 
 namespace wrap {
 
@@ -57,10 +60,17 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
         }
       }
       out.failure.action = std::max(action, 0);
+      out.failure.blame = out.failure.action;
       out.failure.segment = "timed";
       out.failure.suspend = false;
       out.failure.message = "the trajectory check found " + std::to_string(check->issues.size()) +
                             " issue(s), the first: " + FormatTrajectoryIssue(plan, issue);
+      if (const char* dump = std::getenv("WRAP_MOTION_DUMP")) {
+        // Debugging: keep the refused plan (a folder; one file per refusal).
+        static int dumped = 0;
+        (void)SavePlan(plan, std::filesystem::path(dump) /
+                                 ("refused_" + std::to_string(dumped++) + ".json"));
+      }
       plan.trajectories.clear();
       plan.segments.clear();
       plan.stats.motion = false;

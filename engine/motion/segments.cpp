@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <map>
+#include <optional>
 #include <random>
 #include <set>
 #include <utility>
@@ -92,7 +94,8 @@ class Builder {
                         const std::vector<std::pair<int, int>>& mating = {},
                         const std::vector<int>& table_ok = {},
                         const std::vector<std::pair<int, int>>& gripper_ok = {});
-  bool Fail(int action, SegmentKind kind, bool suspend, const std::string& message);
+  bool Fail(int action, SegmentKind kind, bool suspend, const std::string& message,
+            int blame = -1);
   Iso3 Tcp(int robot, const JointVector& q) const {
     const TaskRobot& r = w_.robots[robot];
     return TcpPose(r.chain, r.X_WB, q, r.end_effector.X_FT);
@@ -163,6 +166,13 @@ class Builder {
   // until the input is clear: `goal` (the approach keyframe) gets the holders' joints and the
   // input's pose there, and the insertion skill slides from it. Otherwise `goal` stays.
   void SlideStart(int action, Keyframe& goal);
+  // An insertion whose moved input touches the table top at `goal` (its approach keyframe or
+  // slide start: the input slides along the table into a resting base): the holders come to a
+  // pose lift_m above it instead, and `descent` (their waypoints, top to bottom) lowers it
+  // straight onto the table. `goal` becomes the top; nothing changes when the input is clear of
+  // the table there. False (with the failure set) when no straight descent is clear.
+  bool HoverAbove(int action, Keyframe& goal, std::vector<int>& holders,
+                  std::vector<std::vector<JointVector>>& descent, double* length);
   bool Return(int action, int robot, const JointVector& goal, bool main);
   // Robot r at `q` instead of its joints at the keyframe `kf` (same TCP): collision-free and
   // clear of the other robots there (objects at the keyframe's poses, `mating` allowed).
@@ -191,11 +201,14 @@ class Builder {
   std::vector<JointVector> cur_;
   std::vector<double> opening_;
   std::vector<int> released_;  // per robot: object let go at its last event, not yet backed off
+  std::vector<int> released_at_;  // per robot: the action of that event
   std::set<int> grounded_;     // objects touching the table top
   std::vector<GeoSegment> out_;
   int free_index_ = 0;
   bool cancelled_ = false;
   std::string last_hit_;  // the bodies of the last collision PathClear met
+  bool hover_ = false;    // the carries' goal is a hover pose, not a keyframe: no rebranching
+  bool jump_ = false;     // a segment did not start where its robots were (see Push)
   std::mt19937_64 rng_;
 };
 
@@ -209,9 +222,11 @@ Result<void> Builder::SetScene(const std::vector<double>& openings,
   return scene_.Set(state_, openings, cur_, mating, on_table, gripper_ok);
 }
 
-bool Builder::Fail(int action, SegmentKind kind, bool suspend, const std::string& message) {
+bool Builder::Fail(int action, SegmentKind kind, bool suspend, const std::string& message,
+                   int blame) {
   if (failure_) {
     failure_->action = action;
+    failure_->blame = blame >= 0 ? blame : action;
     failure_->segment = std::string(ToString(kind));
     failure_->suspend = suspend;
     failure_->message = message;
@@ -221,6 +236,16 @@ bool Builder::Fail(int action, SegmentKind kind, bool suspend, const std::string
 
 void Builder::Push(GeoSegment seg) {
   if (seg.openings.empty()) seg.openings = opening_;
+  for (size_t i = 0; i < seg.robots.size() && !seg.waypoints.empty(); ++i) {
+    const int r = seg.robots[i];
+    if ((seg.waypoints.front()[i] - cur_[r]).cwiseAbs().maxCoeff() > 1e-6 && !jump_) {
+      // A bug, not a plan that has no motion: the trajectory would jump.
+      jump_ = true;
+      Fail(seg.action, seg.kind, false,
+           "internal: the " + std::string(ToString(seg.kind)) + " segment of " + Name(r) +
+               " does not start where the robot is");
+    }
+  }
   Sweep(seg);
   for (size_t i = 0; i < seg.robots.size(); ++i) cur_[seg.robots[i]] = seg.waypoints.back()[i];
   out_.push_back(std::move(seg));
@@ -505,7 +530,8 @@ bool Builder::Retreat(int action, int robot) {
   if (back.empty()) {
     return Fail(action, SegmentKind::kRetreat, false,
                 Name(robot) + " cannot back its gripper away from " + NodeName(node) +
-                    " along the gripper axis: " + last_hit_);
+                    " along the gripper axis: " + last_hit_,
+                released_at_[robot]);
   }
   PushSkill(SegmentKind::kRetreat, action, false, robot, node, back, length, opt_.skill_speed_mps);
   released_[robot] = -1;
@@ -656,6 +682,40 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
   std::vector<std::vector<JointVector>> path;
   PathAnswer answer = plan(movers, targets, &path);
   if (answer.solved && reached) *reached = answer.goal_index;
+  if (!answer.solved && answer.timed_out && std::getenv("WRAP_MOTION_DIAG") && movers.size() == 1) {
+    // Diagnosis: is the start or the goal cut off from the robot's home?
+    const JointVector saved = cur_[movers[0]];
+    std::vector<std::vector<JointVector>> p1, p2;
+    const PathAnswer a1 = plan(movers, {w_.robots[movers[0]].home}, &p1);
+    cur_[movers[0]] = targets[0];
+    scene_.SetRobot(movers[0], targets[0]);
+    const PathAnswer a2 = plan(movers, {w_.robots[movers[0]].home}, &p2);
+    cur_[movers[0]] = saved;
+    scene_.SetRobot(movers[0], saved);
+    // What the goal's neighbourhood hits.
+    std::map<std::string, int> hits;
+    {
+      std::mt19937_64 g(7);
+      std::uniform_real_distribution<double> u(-0.05, 0.05);
+      for (int t = 0; t < 64; ++t) {
+        JointVector x = targets[0];
+        for (int j = 0; j < x.size(); ++j) x[j] += u(g);
+        scene_.SetRobot(movers[0], x);
+        CollisionResult res;
+        if (scene_.cell().InCollision(&res)) {
+          const CollisionWorld& cw = scene_.cell().world();
+          ++hits[cw.body_name(res.first.body_a) + " ~ " + cw.body_name(res.first.body_b)];
+        }
+      }
+      scene_.SetRobot(movers[0], saved);
+    }
+    std::string near;
+    for (const auto& [k, v] : hits) near += " " + k + " x" + std::to_string(v);
+    std::fprintf(stderr, "[diag] action %d %s (%s, holds %d): start->home %s, goal->home %s;%s\n",
+                 action + 1, Name(movers[0]).c_str(), main ? "main" : "return",
+                 state_.held[movers[0]], a1.solved ? "yes" : a1.why.c_str(),
+                 a2.solved ? "yes" : a2.why.c_str(), near.c_str());
+  }
   std::vector<int> who = movers;
   if (!answer.solved && answer.timed_out && effort_ > 0 && !ctx_.ShouldStop()) {
     // The idle robots (free, not in this segment) may step aside and come back.
@@ -835,7 +895,11 @@ bool Builder::CarryEnd(const std::vector<int>& holders, const std::vector<JointV
     const double off = (last[i] - goal_q[i]).cwiseAbs().maxCoeff();
     const JointVector same_pose =
         NearestEquivalent(w_.robots[holders[i]].chain, goal_q[i], last[i]);
-    if (off > kMaxSnap && (same_pose - last[i]).cwiseAbs().maxCoeff() <= kMaxSnap) {
+    if (off > kMaxSnap && hover_) {
+      why = Name(holders[i]) + " ends " + std::to_string(off).substr(0, 4) +
+            " rad away from its joints above the insertion's start";
+      return false;
+    } else if (off > kMaxSnap && (same_pose - last[i]).cwiseAbs().maxCoeff() <= kMaxSnap) {
       // The keyframe's joints up to turns of 2 pi: the same configuration.
       rebranch.push_back({i, same_pose});
       last[i] = same_pose;
@@ -1026,14 +1090,20 @@ void Builder::SlideStart(int action, Keyframe& goal) {
   const std::vector<int> holders = state_.Holders(m_node);
   if (holders.empty()) return;
   const int h0 = holders[0];
-  if (KeyframeAccepts(h0, goal.q[h0], goal, {})) return;                  // clear already
-  if (!KeyframeAccepts(h0, goal.q[h0], goal, {{m_node, b_node}})) return;  // not that contact
+  const bool clear = KeyframeAccepts(h0, goal.q[h0], goal, {});
+  if (clear && !Tight(h0, goal.q[h0])) return;  // clear, with room around it
+  if (!clear && !KeyframeAccepts(h0, goal.q[h0], goal, {{m_node, b_node}})) return;  // not that
   Vec3 u = Tcp(h0, goal.q[h0]).translation() - Tcp(h0, a.keyframe.q[h0]).translation();
   if (u.norm() < 1e-6) return;
   u.normalize();
   std::vector<JointVector> q0;
   for (int r : holders) q0.push_back(goal.q[r]);
-  for (double extra : {0.01, 0.02, 0.04, 0.06}) {
+  // Further back along the insertion line: the first start that is clear with room around it
+  // (a free path hardly reaches a start in a pocket, e.g. a long bolt still near its hole);
+  // else the first clear one when the approach keyframe touches the base.
+  std::optional<Keyframe> first_clear;
+  double first_extra = 0.0;
+  for (double extra : {0.01, 0.02, 0.04, 0.06, 0.09, 0.12}) {
     std::vector<std::function<Iso3(double)>> targets;
     for (int r : holders) {
       const Iso3 Xa = Tcp(r, goal.q[r]);
@@ -1051,16 +1121,107 @@ void Builder::SlideStart(int action, Keyframe& goal) {
     for (PlanObject& o : pre.objects) {
       if (o.node == m_node) o.X_WA.translation() += extra * u;
     }
-    if (KeyframeAccepts(h0, pre.q[h0], pre, {})) {
+    if (!KeyframeAccepts(h0, pre.q[h0], pre, {})) continue;
+    if (!Tight(h0, pre.q[h0])) {
       if (std::getenv("WRAP_MOTION_DEBUG")) {
-        std::fprintf(stderr, "[slide] action %d: %s touches %s at the approach; the slide starts "
-                     "%.0f mm further back\n", action + 1, NodeName(m_node).c_str(),
+        std::fprintf(stderr,
+                     "[slide] action %d: %s %s %s at the approach; the slide starts %.0f mm "
+                     "further back\n",
+                     action + 1, NodeName(m_node).c_str(), clear ? "is close to" : "touches",
                      NodeName(b_node).c_str(), 1000.0 * extra);
       }
       goal = std::move(pre);
       return;
     }
+    if (!clear && !first_clear) {
+      first_clear = std::move(pre);
+      first_extra = extra;
+    }
   }
+  if (first_clear) {
+    if (std::getenv("WRAP_MOTION_DEBUG")) {
+      std::fprintf(stderr,
+                   "[slide] action %d: %s touches %s at the approach; the slide starts %.0f mm "
+                   "further back (still tight)\n",
+                   action + 1, NodeName(m_node).c_str(), NodeName(b_node).c_str(),
+                   1000.0 * first_extra);
+    }
+    goal = std::move(*first_clear);
+  }
+}
+
+bool Builder::HoverAbove(int action, Keyframe& goal, std::vector<int>& holders,
+                         std::vector<std::vector<JointVector>>& descent, double* length) {
+  // An input this close above the table top touches it [m].
+  constexpr double kTouch = 2e-3;
+  const PlanAction& a = plan_.actions[action];
+  if (a.objects.size() < 2) return true;
+  const int m_node = a.objects[0], b_node = a.objects[1];
+  const PlanObject* mo = FindObject(goal, m_node);
+  if (mo == nullptr || LowestPoint(w_, m_node, mo->X_WA) > w_.table_top + kTouch) return true;
+  holders = state_.Holders(m_node);
+  if (holders.empty()) return true;
+  // The scene at the goal: the objects where the keyframe has them, every robot at its joints.
+  PlanState at = state_;
+  for (const PlanObject& o : goal.objects) {
+    if (auto it = at.objects.find(o.node); it != at.objects.end()) it->second.X_WA = o.X_WA;
+  }
+  std::vector<JointVector> q0;
+  for (int r : holders) q0.push_back(goal.q[r]);
+  // Straight down onto the table; else down and forward along the slide (from above and behind
+  // its start), where the space above the start is taken.
+  std::vector<Vec3> dirs = {Vec3::UnitZ()};
+  Vec3 back = Tcp(holders[0], goal.q[holders[0]]).translation() -
+              Tcp(holders[0], a.keyframe.q[holders[0]]).translation();
+  back.z() = 0.0;
+  if (back.norm() > 1e-6) dirs.push_back((Vec3::UnitZ() + back.normalized()).normalized());
+  std::string why = "no IK solution along the line";
+  for (const Vec3& dir : dirs) {
+    for (double d : {opt_.lift_m, 2 * opt_.lift_m, opt_.lift_m / 2}) {
+      const double len = d / dir.z();
+      std::vector<std::function<Iso3(double)>> targets;
+      for (int r : holders) {
+        const Iso3 X0 = Tcp(r, goal.q[r]);
+        targets.push_back([X0, dir, len](double s) {
+          Iso3 X = X0;
+          X.translation() += s * len * dir;
+          return X;
+        });
+      }
+      auto path = Track(holders, q0, targets,
+                        std::max(2, static_cast<int>(std::ceil(len / opt_.cartesian_step_m))));
+      if (path.empty()) continue;
+      Keyframe top = goal;
+      for (size_t k = 0; k < holders.size(); ++k) top.q[holders[k]] = path.back()[k];
+      for (PlanObject& o : top.objects) {
+        if (o.node == m_node) o.X_WA.translation() += len * dir;
+      }
+      if (!KeyframeAccepts(holders[0], top.q[holders[0]], top, {})) {
+        why = "the pose " + std::to_string(static_cast<int>(std::lround(d * 1000))) +
+              " mm above it collides";
+        continue;
+      }
+      // The way down may touch the table and the base (the slide's contacts).
+      if (!scene_.Set(at, opening_, goal.q, {{m_node, b_node}}, {m_node})) return false;
+      if (!PathClear(holders, path)) {
+        why = last_hit_;
+        continue;
+      }
+      if (std::getenv("WRAP_MOTION_DEBUG")) {
+        std::fprintf(stderr,
+                     "[hover] action %d: %s touches the table at the insertion's start; it is "
+                     "lowered %.0f mm onto it\n",
+                     action + 1, NodeName(m_node).c_str(), 1000.0 * d);
+      }
+      descent.assign(path.rbegin(), path.rend());
+      *length = len;
+      goal = std::move(top);
+      return true;
+    }
+  }
+  return Fail(action, SegmentKind::kDescend, false,
+              "the holders of " + NodeName(m_node) +
+                  " cannot lower it straight onto the table where its insertion starts: " + why);
 }
 
 bool Builder::StageAccepts(int robot, int action, bool from_approach, const JointVector& old_q,
@@ -1137,6 +1298,14 @@ bool Builder::Action(int i) {
   // start of its slide), else the keyframe.
   Keyframe target_kf = assemble && a.approach ? *a.approach : K;
   if (assemble && a.approach) SlideStart(i, target_kf);
+  std::vector<int> hover_holders;
+  std::vector<std::vector<JointVector>> hover_descent;
+  double hover_length = 0.0;
+  if (assemble && a.approach &&
+      !HoverAbove(i, target_kf, hover_holders, hover_descent, &hover_length)) {
+    return false;
+  }
+  hover_ = !hover_descent.empty();
   struct Moving {
     int node;
     std::vector<int> holders;
@@ -1148,7 +1317,10 @@ bool Builder::Action(int i) {
     if (holders.empty()) continue;
     const PlanObject* goal = FindObject(target_kf, node);
     if (goal == nullptr) continue;
-    if (!SamePose(goal->X_WA, o.X_WA)) moving.push_back({node, holders, goal->X_WA});
+    // A placement moves its object even to where it was (its carrier comes to the descent).
+    if (!SamePose(goal->X_WA, o.X_WA) || (a.type == ActionType::kPlace && node == grasped)) {
+      moving.push_back({node, holders, goal->X_WA});
+    }
   }
   // Robots that let go and stayed back off first.
   for (int r : a.robots) {
@@ -1379,7 +1551,12 @@ bool Builder::Action(int i) {
     }
     if (!ok) return false;
   }
+  hover_ = false;
   // The final skills.
+  if (!hover_descent.empty()) {
+    PushSkill(SegmentKind::kDescend, i, true, hover_holders, {a.objects[0]},
+              std::move(hover_descent), hover_length, opt_.skill_speed_mps);
+  }
   if (a.type == ActionType::kPlace) {
     PushSkill(SegmentKind::kDescend, i, true, a.robots[0], grasped, descend, opt_.lift_m,
               opt_.skill_speed_mps);
@@ -1465,12 +1642,15 @@ bool Builder::Action(int i) {
     case ActionType::kPlace:
       grounded_.insert(grasped);
       released_[a.robots[0]] = grasped;
+      released_at_[a.robots[0]] = i;
       break;
     case ActionType::kRelease:
       released_[a.robots[0]] = grasped;
+      released_at_[a.robots[0]] = i;
       break;
     case ActionType::kHandover:
       released_[a.robots[0]] = grasped;
+      released_at_[a.robots[0]] = i;
       break;
     case ActionType::kAssemble: {
       const bool base_grounded = grounded_.count(a.objects[1]) > 0;
@@ -1496,12 +1676,13 @@ Result<std::vector<GeoSegment>> Builder::Run() {
   cur_ = plan_.initial.q;
   opening_.assign(n_robots, -1.0);
   released_.assign(n_robots, -1);
+  released_at_.assign(n_robots, -1);
   for (const PlanObject& o : plan_.initial.objects) {
     if (o.resting) grounded_.insert(o.node);
   }
   for (size_t i = 0; i < plan_.actions.size(); ++i) {
     if (ctx_.cancelled()) return wrap::Fail(ErrorCode::kCancelled, "motion planning cancelled");
-    if (!Action(static_cast<int>(i))) {
+    if (!Action(static_cast<int>(i)) || jump_) {
       if (cancelled_ || ctx_.cancelled()) {
         return wrap::Fail(ErrorCode::kCancelled, "motion planning cancelled");
       }
@@ -1512,7 +1693,7 @@ Result<std::vector<GeoSegment>> Builder::Run() {
   const int last = static_cast<int>(plan_.actions.size()) - 1;
   state_ = states_.back();
   for (int r = 0; r < n_robots; ++r) {
-    if (!Return(std::max(last, 0), r, plan_.initial.q[r], false)) {
+    if (!Return(std::max(last, 0), r, plan_.initial.q[r], false) || jump_) {
       if (cancelled_ || ctx_.cancelled()) {
         return wrap::Fail(ErrorCode::kCancelled, "motion planning cancelled");
       }

@@ -69,6 +69,9 @@ struct GeoSegment {
 /// Why the geometric motion of a plan could not be made.
 struct MotionFailure {
   int action = -1;       ///< Action of the segment.
+  /// The action whose keyframe made it fail (the task plan's edge to avoid): the segment's own,
+  /// or, for a retreat, the action that let go.
+  int blame = -1;
   std::string segment;   ///< Its kind.
   bool suspend = false;  ///< True when more effort may find it (a path search ran out of time).
   std::string message;   ///< The segment and the reason, in words.

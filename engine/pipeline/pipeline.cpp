@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -26,7 +27,15 @@ struct Candidate {
   MotionCache cache;
   int effort = 0;
   int order = 0;  // arrival
+  std::uint64_t stuck = 0;  // edge of the action where its motion was last suspended
 };
+
+// The sequence of the task search's edges of a plan (two plans with the same one are the same).
+std::uint64_t Signature(const Plan& plan) {
+  std::uint64_t h = 0x5157;
+  for (const PlanAction& a : plan.actions) h = (h ^ a.edge) * 0x100000001b3ULL + 0x9e37;
+  return h;
+}
 
 }  // namespace
 
@@ -55,6 +64,10 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
   double t_retime = 0.0;
   std::optional<Plan> fallback;  // the first task plan, returned when no motion is found
   std::string last_failure;
+  // Motion feedback: the edges of the task plans whose motion failed for good (a skill that
+  // collides, a goal in collision, or every effort spent) are not taken by later task plans;
+  // without it a task search that does not depend on its seed would make the same plan again.
+  std::set<std::uint64_t> banned;
   const std::uint64_t seed = options.seed;
   first->stats.seed = seed;
 
@@ -91,6 +104,13 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
     if ((queue.empty() || (all_suspended && room)) && made < options.max_task_plans) {
       TaskPlannerOptions task = options.task;
       task.optimize = false;
+      task.banned_edges.insert(banned.begin(), banned.end());
+      // A new plan goes around the places where the queued ones are stuck (they keep their
+      // turn with more effort); otherwise a search that does not depend on its seed would
+      // make one of them again.
+      for (const Candidate& c : queue) {
+        if (c.stuck != 0) task.banned_edges.insert(c.stuck);
+      }
       RunContext sub(seed + 7919ULL * static_cast<std::uint64_t>(made));
       sub.set_deadline(ctx.deadline());
       sub.set_stop_token(ctx.stop_token());
@@ -100,7 +120,13 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
         if (next.error().code == ErrorCode::kCancelled) return std::unexpected(next.error());
       } else if (next->stats.solved) {
         next->stats.seed = seed + 7919ULL * static_cast<std::uint64_t>(made - 1);
-        if (auto ok = enqueue(std::move(*next)); !ok) return std::unexpected(ok.error());
+        const std::uint64_t sig = Signature(*next);
+        const bool known = std::any_of(queue.begin(), queue.end(), [&](const Candidate& c) {
+          return Signature(c.plan) == sig;
+        });
+        if (!known) {
+          if (auto ok = enqueue(std::move(*next)); !ok) return std::unexpected(ok.error());
+        }
       }
       continue;
     }
@@ -136,10 +162,16 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
       std::fprintf(stderr, "[motion] plan %d effort %d: %s%s\n", c.order, c.effort,
                    last_failure.c_str(), f.suspend ? " (suspended)" : "");
     }
+    const int blame = f.blame >= 0 ? f.blame : f.action;
+    const std::uint64_t edge = blame >= 0 && blame < static_cast<int>(c.plan.actions.size())
+                                   ? c.plan.actions[blame].edge
+                                   : 0;
     if (f.suspend && c.effort < options.motion.max_effort) {
       ++c.effort;  // Suspend: more effort later
       ++suspensions;
+      c.stuck = edge;
     } else {
+      if (edge != 0) banned.insert(edge);
       queue.erase(queue.begin() + static_cast<long>(pick));
     }
   }

@@ -107,6 +107,10 @@ struct PlanAction {
   /// insertion is a straight move from here to `keyframe`.
   std::optional<Keyframe> approach;
   int milestone = -1;  ///< Index of the milestone (step in planning order) it belongs to.
+  /// The task search's key of the edge that made it (symbolic state before it and the action),
+  /// for the motion stage's feedback (TaskPlannerOptions::banned_edges); 0 when unknown (a plan
+  /// read from a file). Not saved.
+  std::uint64_t edge = 0;
   /// Once retimed: when the first motion toward this action starts [s]; -1 without motion.
   double start_s = -1.0;
   /// Once retimed: the moment of the keyframe (grasp closed, gripper about to open, mated), when

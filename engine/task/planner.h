@@ -20,7 +20,9 @@
 // `optimize`, windows of milestones are searched again for a cheaper plan until the time limit.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <set>
 #include <string>
 
 #include "core/result.h"
@@ -58,6 +60,9 @@ struct TaskPlannerOptions {
   long long max_nodes = 400000;        ///< Search nodes kept per milestone search (memory bound).
   int max_backtracks = 6;              ///< Milestone re-plans after later milestones failed.
   std::filesystem::path project_file;  ///< Resolves URDF robots; may be empty.
+  /// Edges (PlanAction::edge of earlier plans) the search must not take: the motion stage's
+  /// feedback, an action whose motion could not be made in an earlier task plan.
+  std::set<std::uint64_t> banned_edges;
 };
 
 /// Plans the task of a validated project (`check` from LoadProject, `pre` from Preprocess).

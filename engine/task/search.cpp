@@ -94,7 +94,10 @@ TaskSearch::TaskSearch(const TaskWorld& world, TaskTables& tables, KeyframeSolve
       flat_(options.planner == "flat"),
       optimistic_(options.planner == "optimistic"),
       flat_order_(world.tree->step_order),
-      rss0_(ResidentMemoryBytes()) {}
+      rss0_(ResidentMemoryBytes()) {
+  // Edges on which the motion of an earlier task plan failed: never taken (motion feedback).
+  for (std::uint64_t edge : options.banned_edges) failed_level_[edge] = kPermanent;
+}
 
 TaskSearch::Milestone TaskSearch::StepMilestone(int step, int next_step) const {
   Milestone m;
@@ -752,6 +755,7 @@ PlanAction TaskSearch::MakeAction(const SymState& s, const TaskAction& a, const 
   PlanAction p;
   p.type = a.type;
   p.milestone = milestone;
+  p.edge = EdgeKey(s, a);
   p.keyframe = e.keyframe;
   p.approach = e.approach;
   auto hold = [&](int robot, int grasp_id) {
