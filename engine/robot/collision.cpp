@@ -85,6 +85,15 @@ class MeshTreeCache {
     return model;
   }
 
+  int Live() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    int n = 0;
+    for (const auto& [h, bucket] : entries_) {
+      for (const Entry& e : bucket) n += !e.tree.expired();
+    }
+    return n;
+  }
+
  private:
   struct Entry {
     std::weak_ptr<const Tree> tree;
@@ -712,6 +721,8 @@ CollisionWorld& CollisionWorld::operator=(const CollisionWorld& other) {
 }
 CollisionWorld::CollisionWorld(CollisionWorld&&) noexcept = default;
 CollisionWorld& CollisionWorld::operator=(CollisionWorld&&) noexcept = default;
+
+int CollisionWorld::LiveMeshTrees() { return MeshTrees().Live(); }
 
 Result<BodyId> CollisionWorld::AddBody(const BodyDef& def) {
   Impl& m = *impl_;

@@ -140,7 +140,11 @@ class CollisionWorld {
   /// Adds a body and returns its id. Fails with kInvalidInput naming the body and the shape for
   /// a group outside [0, kMaxCollisionGroups), a non-positive or non-finite size, a degenerate
   /// cylinder axis or an empty mesh. Capsules of zero length are spheres. Sphere: centre p0.
+  /// A mesh equal (vertex by vertex) to one that some world of the process already holds shares
+  /// that world's FCL tree instead of building another.
   Result<BodyId> AddBody(const BodyDef& def);
+  /// Mesh trees alive in the process (each shared by every world holding its mesh).
+  static int LiveMeshTrees();
 
   /// Number of bodies.
   int num_bodies() const;

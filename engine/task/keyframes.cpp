@@ -73,6 +73,8 @@ std::string_view GateName(Gate gate) {
       return "wrench (release)";
     case Gate::kWrenchRest:
       return "wrench (rest)";
+    case Gate::kSkill:
+      return "straight approach, retreat or descent";
   }
   return "?";
 }
@@ -789,6 +791,7 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
         case Gate::kClearance:
           return 6;
         case Gate::kApproach:
+        case Gate::kSkill:
           return 7;
       }
       return 0;
@@ -927,7 +930,7 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
           const TaskRobot& R = world_.robots[r];
           const Vec3 back = -TcpPose(R.chain, R.X_WB, q[i], R.end_effector.X_FT).linear().col(2);
           if (!StraightClear(r, q[i], back, kStraightM, &why_straight)) {
-            search_gate = Gate::kApproach;
+            search_gate = Gate::kSkill;
             leaf_message = "'" + R.name + "' cannot approach its grasp straight along the " +
                            "gripper axis: " + why_straight;
             return false;
@@ -950,14 +953,14 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
               cell_.world().SetAllowed(cell_.object_body(p), cell_.end_effector_body(r), true);
             }
             if (!down) {
-              search_gate = Gate::kApproach;
+              search_gate = Gate::kSkill;
               leaf_message =
                   "'" + R.name + "' cannot set its object down straight: " + why_straight;
               return false;
             }
           }
           if (!StraightClear(r, qr, -X_WT.linear().col(2), kRetreatM, &why_straight)) {
-            search_gate = Gate::kApproach;
+            search_gate = Gate::kSkill;
             leaf_message = "'" + R.name + "' cannot back its gripper away straight after " +
                            "letting go: " + why_straight;
             return false;

@@ -34,10 +34,11 @@ enum class Gate {
   kWrenchTransport,
   kWrenchRelease,
   kWrenchRest,
+  kSkill,  ///< No room for a straight approach, retreat or descent at the keyframe.
 };
 /// Words for a gate, e.g. "IK", "collision", "wrench (assembly)".
 std::string_view GateName(Gate gate);
-inline constexpr int kNumGates = 11;
+inline constexpr int kNumGates = 12;
 
 /// Counters and times of the checks.
 struct TaskCounters {
@@ -91,6 +92,13 @@ class KeyframeSolver {
   /// Cheap and context-free: `node` resting at X_WA leaves every robot room to stand at home
   /// (no link, end effector or finger of a robot at its home configuration touches it).
   bool ClearOfHomes(int node, const Iso3& X_WA);
+  /// Robot `robot` from `q` moves its TCP straight by `length_m` along `dir_W` without hitting
+  /// anything in the cell as the last validation left it (its keyframe), checked at a few points
+  /// on the arm's IK branch: the straight approach to a grasp, the retreat from a release, the
+  /// descent of a placement, which the motion stage makes as skills. Restores `q`. False with
+  /// the reason in `why`.
+  bool StraightClear(int robot, const JointVector& q, const Vec3& dir_W, double length_m,
+                     std::string* why);
   /// Finger opening of a robot holding with `grasp` (width plus clearance).
   double GraspOpening(int grasp) const;
   /// The wrench gate for `objects` (cached by `key`, which must identify the question), with the
@@ -123,12 +131,6 @@ class KeyframeSolver {
   void SetRobot(int robot, const JointVector& q);
   void EnableRobot(int robot, bool on);
   bool Collides();
-  /// Robot `robot` from `q` moves its TCP straight by `length_m` along `dir_W` (the other robots
-  /// and the objects as set) without hitting anything, checked at a few points on its IK branch:
-  /// the straight approach to a grasp, the retreat from a release, the descent of a placement,
-  /// which the motion stage makes as skills. Restores `q`. False with the reason in `why`.
-  bool StraightClear(int robot, const JointVector& q, const Vec3& dir_W, double length_m,
-                     std::string* why);
   bool Search(const std::vector<Mover>& movers, const std::vector<std::vector<JointVector>>& sols,
               size_t depth, std::vector<JointVector>& chosen, int& leaves, Gate& gate,
               const std::function<bool(std::vector<JointVector>&)>& leaf);

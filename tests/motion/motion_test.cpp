@@ -377,9 +377,8 @@ TEST_F(Handmade, TrapezoidTimesMatchHandComputedOnes) {
     GeoSegment seg;
     seg.kind = SegmentKind::kFree;
     seg.robots = {0};
-    JointVector q0 = plan.initial.q[0];
-    JointVector q1 = q0;
-    q1[0] += d;
+    const JointVector q0 = plan.initial.q[0];
+    const JointVector q1 = q0 + d * JointVector::Unit(q0.size(), 0);
     seg.waypoints = {{q0}, {q1}, {q0}};
     seg.openings.assign(plan.robots.size(), -1.0);
     auto timing = Retime(w, plan, {seg});
@@ -399,8 +398,8 @@ TEST_F(Handmade, TrapezoidTimesMatchHandComputedOnes) {
   GeoSegment skill;
   skill.kind = SegmentKind::kApproach;
   skill.robots = {0};
-  JointVector q1 = plan.initial.q[0];
-  q1[5] += 0.01;
+  const JointVector q1 =
+      plan.initial.q[0] + 0.01 * JointVector::Unit(plan.initial.q[0].size(), 5);
   skill.waypoints = {{plan.initial.q[0]}, {q1}};
   skill.skill_length_m = 0.04;
   skill.skill_speed_mps = 0.05;
@@ -417,8 +416,8 @@ TEST_F(Handmade, IndependentRobotsOverlapAndSharedOnesWait) {
     GeoSegment seg;
     seg.kind = SegmentKind::kFree;
     seg.robots = {r};
-    JointVector q1 = plan.initial.q[r];
-    q1[0] += 0.3;
+    const JointVector q1 =
+        plan.initial.q[r] + 0.3 * JointVector::Unit(plan.initial.q[r].size(), 0);
     seg.waypoints = {{plan.initial.q[r]}, {q1}, {plan.initial.q[r]}};
     seg.openings.assign(plan.robots.size(), -1.0);
     seg.sweep = {{box, box}};
@@ -436,6 +435,45 @@ TEST_F(Handmade, IndependentRobotsOverlapAndSharedOnesWait) {
   auto same_robot = Retime(w, plan, {wave(0, left), wave(0, right)});
   ASSERT_TRUE(same_robot);
   EXPECT_NEAR(same_robot->makespan_s, same_robot->makespan_sequential_s, 1e-9);
+}
+
+// A placement at the pose its object already has (the task planner may pick an object and set
+// it down right there to change how an arm holds it) still lifts the object and lowers it again;
+// before, the descent started where the robot was not and the trajectory jumped.
+TEST_F(Handmade, APlacementWhereTheObjectAlreadyIsStillMovesIt) {
+  const TaskWorld& w = *planned_->world;
+  Plan plan = *planned_->plan;
+  ASSERT_FALSE(plan.actions.empty());
+  if (plan.actions.front().type != ActionType::kPick) GTEST_SKIP() << "no pick first";
+  plan.actions.resize(1);
+  PlanAction place = plan.actions.front();
+  place.type = ActionType::kPlace;
+  place.approach.reset();
+  place.placement = PlanPlacement{0, 0, 0};
+  for (PlanObject& o : place.keyframe.objects) {
+    if (o.node == place.objects.front()) o.resting = true;
+  }
+  plan.actions.push_back(place);
+  plan.trajectories.clear();
+  plan.segments.clear();
+  for (PlanAction& a : plan.actions) a.start_s = a.end_s = -1.0;
+  MotionCache cache;
+  RunContext ctx(1);
+  auto attempt = PlanMotion(w, plan, MotionOptions{}, 0, 1, cache, ctx);
+  ASSERT_TRUE(attempt) << attempt.error().message;
+  ASSERT_TRUE(attempt->solved) << attempt->failure.message;
+  bool lift = false, descend = false;
+  for (const MotionSegment& m : plan.segments) {
+    lift = lift || (m.action == 1 && m.kind == "lift");
+    descend = descend || (m.action == 1 && m.kind == "descend");
+  }
+  EXPECT_TRUE(lift);
+  EXPECT_TRUE(descend);
+  auto check = CheckTrajectories(w, plan, {});
+  ASSERT_TRUE(check);
+  std::string issues;
+  for (const TrajectoryIssue& i : check->issues) issues += FormatTrajectoryIssue(plan, i) + "\n";
+  EXPECT_TRUE(check->valid) << issues;
 }
 
 TEST_F(Handmade, TheCheckCatchesPlantedFaults) {

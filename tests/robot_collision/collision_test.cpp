@@ -212,6 +212,60 @@ TEST(CollisionWorld, MeshVsMesh) {
   EXPECT_NEAR(w.Distance(a, b).distance, 0.4 - 0.1 * std::sqrt(2.0) - 0.1, kGjk);
 }
 
+// Equal meshes share one FCL tree across worlds (cells are rebuilt per task plan and finger
+// opening); a different mesh gets its own; trees go when no world holds them.
+TEST(CollisionWorld, EqualMeshesShareOneTree) {
+  const int before = CollisionWorld::LiveMeshTrees();
+  {
+    const TriangleMesh m = BoxMesh({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1});
+    CollisionWorld w1;
+    Add(w1, "a", 0, {MeshShape(m)});
+    Add(w1, "b", 0, {MeshShape(m)}, Translation(1, 0, 0));
+    EXPECT_EQ(CollisionWorld::LiveMeshTrees(), before + 1);
+    CollisionWorld w2;
+    Add(w2, "a", 0, {MeshShape(m)});
+    EXPECT_EQ(CollisionWorld::LiveMeshTrees(), before + 1);
+    Add(w2, "c", 0, {MeshShape(BoxMesh({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.2}))});
+    EXPECT_EQ(CollisionWorld::LiveMeshTrees(), before + 2);
+    // The shared tree answers for both worlds.
+    w2.SetPose(w2.FindBody("a"), Translation(0.15, 0, 0));
+    EXPECT_TRUE(w2.AnyCollision());
+    EXPECT_FALSE(w1.AnyCollision());
+  }
+  EXPECT_EQ(CollisionWorld::LiveMeshTrees(), before);
+}
+
+// A pair found apart is not tested again until one of its bodies moves: moving either one into
+// the other is still found, and so is a pair whose contact is forbidden again.
+TEST(CollisionWorld, PairsFoundApartAreRetestedWhenABodyMoves) {
+  CollisionWorld w;
+  const BodyId a = Add(w, "a", 0, {MeshShape(BoxMesh({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}))});
+  // b turned 45 degrees next to a's corner: their boxes overlap, the cubes are 4 cm apart.
+  const Iso3 apart = Pose({0.2, 0.2, 0}, {0, 0, std::numbers::pi / 4});
+  const BodyId b =
+      Add(w, "b", 1, {MeshShape(BoxMesh({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}))}, apart);
+  EXPECT_FALSE(w.AnyCollision());
+  EXPECT_FALSE(w.AnyCollision());
+  w.SetPose(b, apart);  // the same pose: nothing moved
+  EXPECT_FALSE(w.AnyCollision());
+  w.SetPose(b, Translation(0.15, 0.0, 0.0));
+  EXPECT_TRUE(w.AnyCollision());
+  w.SetPose(b, apart);
+  EXPECT_FALSE(w.AnyCollision());
+  w.SetPose(a, Translation(0.1, 0.1, 0.0));  // now the other one moves in
+  EXPECT_TRUE(w.AnyCollision());
+  w.SetAllowed(a, b, true);
+  EXPECT_FALSE(w.AnyCollision());
+  w.SetAllowed(a, b, false);
+  EXPECT_TRUE(w.AnyCollision());
+  // Whatever the margin, the answer is the exact one plus the margin's.
+  w.SetPose(a, Iso3::Identity());
+  CollisionRequest near;
+  near.margin_m = 0.2;
+  EXPECT_FALSE(w.AnyCollision());
+  EXPECT_TRUE(w.AnyCollision(near));
+}
+
 // Nearest points of primitive-vs-mesh pairs come back in the world frame and in argument order,
 // whatever FCL's conventions for the pair (STACK.md quirks).
 TEST(CollisionWorld, MeshVsPrimitiveNearestPointsInWorldFrame) {

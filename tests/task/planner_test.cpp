@@ -61,6 +61,79 @@ TEST(KeyframeSolver, GrippersOfTwoHandsKeepTheirClearance) {
   EXPECT_TRUE(some_apart);
 }
 
+// The straight moves that the motion stage makes as skills are checked at the keyframe: after a
+// pick of a leg lying on the table, the gripper backs off along its axis (the planner keeps only
+// keyframes where it can), and 2 cm straight down runs it into the table top.
+TEST(KeyframeSolver, StraightMovesAreCheckedAtTheKeyframe) {
+  SolverRig rig;
+  ASSERT_EQ(rig.Build("stool"), "");
+  const TaskWorld& world = *rig.world;
+  KeyframeSolver& solver = *rig.solver;
+  const int leg = 1, robot = 0;  // ur5e_a, two-finger gripper
+  ASSERT_EQ(world.tree->nodes[leg].name, "leg1");
+  const GraspSet* set = world.grasp_set(leg, robot);
+  ASSERT_NE(set, nullptr);
+  // The initial state, as the planner makes it: parts where they start, robots at home.
+  const int n_robots = static_cast<int>(world.robots.size());
+  SymState s;
+  s.loc.assign(world.num_nodes, kInactive);
+  s.held.assign(n_robots, -1);
+  s.grasp.assign(n_robots, -1);
+  ContState c;
+  c.X_WA.assign(world.num_nodes, Iso3::Identity());
+  for (int p = 0; p < world.num_parts; ++p) {
+    s.loc[p] = static_cast<int16_t>(rig.tables.InitialLocation(p, world.initial_X_WA[p]));
+    c.X_WA[p] = world.initial_X_WA[p];
+  }
+  for (const TaskRobot& r : world.robots) c.q.push_back(r.home);
+  bool checked = false;
+  for (size_t i = 0; i < set->grasps.size() && !checked; ++i) {
+    const Grasp& g = set->grasps[i];
+    TaskAction a;
+    a.type = ActionType::kPick;
+    a.r1 = robot;
+    a.obj = leg;
+    a.grasp = rig.tables.Grasp(leg, static_cast<int>(i),
+                               GraspRef{leg, static_cast<int>(i), g.part, g.X_PG, g.width_m,
+                                        g.quality});
+    SymState next = s;
+    next.held[robot] = leg;
+    next.grasp[robot] = a.grasp;
+    next.loc[leg] = kInAir;
+    const EdgeOutcome out = solver.Validate(s, c, a, next, 2, 1);
+    if (!out.ok) continue;
+    const TaskRobot& r = world.robots[robot];
+    const JointVector& q = out.keyframe.q[robot];
+    const Iso3 X_WT = TcpPose(r.chain, r.X_WB, q, r.end_effector.X_FT);
+    std::string why;
+    EXPECT_TRUE(solver.StraightClear(robot, q, -X_WT.linear().col(2), 0.02, &why)) << why;
+    EXPECT_FALSE(solver.StraightClear(robot, q, -Vec3::UnitZ(), 0.02, &why));
+    EXPECT_NE(why.find("table"), std::string::npos) << why;
+    checked = true;
+  }
+  EXPECT_TRUE(checked) << "no grasp of leg1 validated";
+}
+
+// Motion feedback: an edge that the motion stage could not make is never taken again. The
+// stool planned again with the first plan's first action banned gets another first action, and
+// its plan is still valid.
+TEST(PlannerFeedback, BannedEdgesAreNotTaken) {
+  const fs::path file = ProjectFile("stool");
+  const LoadedProject lp = LoadProject(file);
+  ASSERT_TRUE(lp.ok());
+  const PlanRun a = PlanAndValidate(*lp.project, lp.check, file, 3, 120.0);
+  ASSERT_TRUE(a.plan && a.plan->stats.solved);
+  const std::uint64_t banned = a.plan->actions.front().edge;
+  ASSERT_NE(banned, 0u);
+  TaskPlannerOptions options;
+  options.banned_edges = {banned};
+  const PlanRun b = PlanAndValidate(*lp.project, lp.check, file, 3, 120.0, options);
+  ASSERT_TRUE(b.plan && b.plan->stats.solved) << (b.plan ? b.plan->stats.failure : "");
+  ASSERT_TRUE(b.validation);
+  EXPECT_TRUE(b.validation->valid) << Issues(*b.validation);
+  for (const PlanAction& x : b.plan->actions) EXPECT_NE(x.edge, banned);
+}
+
 // Every example project is planned within a generous limit and the plan passes the validator.
 class ExamplePlan : public ::testing::TestWithParam<std::string> {};
 
