@@ -33,8 +33,12 @@ struct PathQuery {
   /// Checked while planning: true stops at once (cancellation).
   std::function<bool()> stop;
   int shortcut_attempts = 60;  ///< Random shortcut attempts after the path is found.
-  /// RRT-Connect's extension length, per square root of the dimension [rad].
-  double range_per_sqrt_dim = 0.4;
+  /// RRT-Connect's extension length, per square root of the dimension [rad]. OMPL's RRT-Connect
+  /// keeps an extension only when all of it is free, so a tree rooted in a pocket (a pre-grasp
+  /// pose next to a part, a hand between two arms) grows only by short ones: at 0.4 the ten
+  /// example projects got motion in 27 of 30 runs (seeds 0-2, 60 s), at 0.2 in 29, with the
+  /// easy ones as fast as before.
+  double range_per_sqrt_dim = 0.2;
 };
 
 /// What PlanPath found.

@@ -508,6 +508,90 @@ bool KeyframeSolver::StraightClear(int robot, const JointVector& q, const Vec3& 
   return ok;
 }
 
+bool KeyframeSolver::CarryClear(int node, const std::vector<int>& holders,
+                                const std::vector<int>& grasps, const std::vector<JointVector>& q0,
+                                const Iso3& X_a, const Iso3& X_b, std::string* why) {
+  const Eigen::Quaterniond qa(X_a.linear());
+  const Eigen::Quaterniond qb(X_b.linear());
+  const double dist = (X_b.translation() - X_a.translation()).norm();
+  const double angle = qa.angularDistance(qb);
+  const int n = std::clamp(static_cast<int>(std::ceil(std::max(dist / 0.03, angle / 0.1))), 8, 40);
+  std::vector<Iso3> X_AT;
+  for (int g : grasps) {
+    const GraspRef& ref = tables_.grasp(g);
+    X_AT.push_back(world_.X_AP[ref.part] * ref.X_PG);
+  }
+  const auto& parts = world_.tree->nodes[node].parts;
+  std::string last = "no IK solution near the last one for an arm";
+  for (int variant = 0; variant < 2; ++variant) {
+    std::vector<JointVector> prev = q0;
+    bool ok = true;
+    for (int k = 1; k <= n && ok; ++k) {
+      const double s = static_cast<double>(k) / n;
+      double st = s;
+      Vec3 lift = Vec3::Zero();
+      if (variant == 1) {
+        lift.z() = 0.10 * std::min(1.0, std::min(4 * s, 4 * (1 - s)));
+        st = std::clamp(2 * s - 0.5, 0.0, 1.0);
+      }
+      Iso3 X = Iso3::Identity();
+      X.linear() = qa.slerp(s, qb).toRotationMatrix();
+      X.translation() = (1 - st) * X_a.translation() + st * X_b.translation() + lift;
+      for (size_t i = 0; i < holders.size() && ok; ++i) {
+        const TaskRobot& r = world_.robots[holders[i]];
+        const Iso3 X_BT = r.X_BW * X * X_AT[i];
+        JointVector next;
+        ++counters_.ik_calls;
+        if (r.ur) {
+          const int branch = r.ur->BranchOf(r.chain, prev[i]);
+          UrIkOptions options;
+          options.q6_if_singular = prev[i][5];
+          const UrIkSolutions sols = r.ur->SolveTcp(X_BT, r.end_effector.X_FT, options);
+          for (int c = 0; c < sols.count; ++c) {
+            if (sols.branch[c] == branch) next = NearestEquivalent(r.chain, sols.q[c], prev[i]);
+          }
+        } else {
+          NumericIkRequest request;
+          request.X_BT = X_BT;
+          request.X_FT = r.end_effector.X_FT;
+          request.seeds = {prev[i]};
+          request.reference = prev[i];
+          NumericIkOptions o;
+          o.restarts = 0;
+          o.position_tolerance_m = 5e-4;
+          o.rotation_tolerance_rad = 5e-3;
+          std::mt19937_64 rng(static_cast<std::uint64_t>(k));
+          auto result = SolveNumericIk(r.chain, request, rng, o);
+          if (result) next = result->q;
+        }
+        // The motion stage tracks in steps of millimetres and refuses jumps of 0.25 rad; a
+        // sample here stands for several of them.
+        if (next.size() == 0 || (next - prev[i]).cwiseAbs().maxCoeff() > 0.6) {
+          last = "'" + r.name + "' cannot follow it on its IK branch";
+          ok = false;
+          break;
+        }
+        prev[i] = next;
+        SetRobot(holders[i], next);
+      }
+      if (!ok) break;
+      for (int p : parts) cell_.SetObjectPose(p, X * world_.X_AP[p]);
+      if (Collides()) {
+        CollisionResult hit;
+        cell_.InCollision(&hit);
+        const CollisionWorld& w = cell_.world();
+        last = hit.collision ? "on the way '" + w.body_name(hit.first.body_a) + "' hits '" +
+                                   w.body_name(hit.first.body_b) + "'"
+                             : "a collision on the way";
+        ok = false;
+      }
+    }
+    if (ok) return true;
+  }
+  if (why) *why = last;
+  return false;
+}
+
 bool KeyframeSolver::Search(const std::vector<Mover>& movers,
                             const std::vector<std::vector<JointVector>>& sols, size_t depth,
                             std::vector<JointVector>& chosen, int& leaves, Gate& gate,
@@ -965,6 +1049,40 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
                            "letting go: " + why_straight;
             return false;
           }
+        }
+      }
+      // A two-handed carry: an object that robots already hold together and whose pose is
+      // sampled must be carried there along one of the motion stage's straight variants, the
+      // rest of the cell as it was (the carry comes before the other robots move).
+      for (int node : reposed) {
+        std::vector<int> holders, grasps;
+        std::vector<JointVector> q0;
+        for (const Mover& m : movers) {
+          if (m.node == node && s.held[m.robot] == node) {
+            holders.push_back(m.robot);
+            grasps.push_back(m.grasp);
+            q0.push_back(c.q[m.robot]);
+          }
+        }
+        if (holders.size() < 2) continue;
+        std::vector<PlanObject> before;
+        std::vector<std::pair<int, int>> holds_before;
+        for (int n2 : keyframe_nodes) before.push_back({n2, c.X_WA[n2], s.loc[n2] >= 0});
+        for (int r = 0; r < n_robots; ++r) {
+          if (s.held[r] >= 0) holds_before.push_back({r, s.grasp[r]});
+        }
+        SetScene(before, holds_before, -1, -1);
+        for (int r = 0; r < n_robots; ++r) SetRobot(r, c.q[r]);
+        std::string why_carry;
+        const bool carried =
+            CarryClear(node, holders, grasps, q0, c.X_WA[node], X[node], &why_carry);
+        SetScene(objects, holds_at_keyframe, allow_a, allow_b);
+        for (size_t i = 0; i < movers.size(); ++i) SetRobot(movers[i].robot, q[i]);
+        if (!carried) {
+          search_gate = Gate::kSkill;
+          leaf_message = "the robots holding '" + world_.tree->nodes[node].name +
+                         "' cannot carry it there together: " + why_carry;
+          return false;
         }
       }
       if (!freed.empty()) {

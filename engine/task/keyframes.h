@@ -99,6 +99,14 @@ class KeyframeSolver {
   /// the reason in `why`.
   bool StraightClear(int robot, const JointVector& q, const Vec3& dir_W, double length_m,
                      std::string* why);
+  /// Object `node`, held by `holders` (grasp ids `grasps`, joints `q0`), is carried from X_a to
+  /// X_b with every holder's TCP following it on the arm's IK branch, straight (translation
+  /// and slerp) or else up 10 cm, across and down, as the motion stage first tries a
+  /// two-handed carry; nothing hits anything in the cell as set (the caller poses the rest).
+  /// Leaves the holders and the object where the last sample put them. False with `why`.
+  bool CarryClear(int node, const std::vector<int>& holders, const std::vector<int>& grasps,
+                  const std::vector<JointVector>& q0, const Iso3& X_a, const Iso3& X_b,
+                  std::string* why);
   /// Finger opening of a robot holding with `grasp` (width plus clearance).
   double GraspOpening(int grasp) const;
   /// The wrench gate for `objects` (cached by `key`, which must identify the question), with the
