@@ -32,7 +32,9 @@ struct PathQuery {
   std::uint64_t seed = 0;     ///< Seeds sampling and shortcutting (deterministic per seed).
   /// Checked while planning: true stops at once (cancellation).
   std::function<bool()> stop;
-  int shortcut_attempts = 60;  ///< Random shortcut attempts after the path is found.
+  /// Random shortcut attempts after the path is found and shortcut greedily (each waypoint
+  /// straight to the farthest later one it sees).
+  int shortcut_attempts = 16;
   /// RRT-Connect's extension length, per square root of the dimension [rad]. OMPL's RRT-Connect
   /// keeps an extension only when all of it is free, so a tree rooted in a pocket (a pre-grasp
   /// pose next to a part, a hand between two arms) grows only by short ones: at 0.4 the ten

@@ -41,7 +41,7 @@ struct MotionOptions {
   double carry_speed_mps = 0.10;    ///< Object speed of a two-handed carry [m/s].
   double grip_s = 0.4;              ///< A gripper closing or opening at a keyframe [s].
   /// Shortcut attempts per free path.
-  int shortcut_attempts = 60;
+  int shortcut_attempts = 16;
   /// Run the independent trajectory check on the timed result; a plan that fails it has no
   /// motion (its first issue is the failure), so no colliding trajectory leaves the planner.
   bool self_check = true;
