@@ -68,8 +68,8 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
       if (const char* dump = std::getenv("WRAP_MOTION_DUMP")) {
         // Debugging: keep the refused plan (a folder; one file per refusal).
         static int dumped = 0;
-        (void)SavePlan(plan, std::filesystem::path(dump) /
-                                 ("refused_" + std::to_string(dumped++) + ".json"));
+        (void)SavePlan(
+            plan, std::filesystem::path(dump) / ("refused_" + std::to_string(dumped++) + ".json"));
       }
       plan.trajectories.clear();
       plan.segments.clear();

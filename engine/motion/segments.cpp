@@ -94,8 +94,7 @@ class Builder {
                         const std::vector<std::pair<int, int>>& mating = {},
                         const std::vector<int>& table_ok = {},
                         const std::vector<std::pair<int, int>>& gripper_ok = {});
-  bool Fail(int action, SegmentKind kind, bool suspend, const std::string& message,
-            int blame = -1);
+  bool Fail(int action, SegmentKind kind, bool suspend, const std::string& message, int blame = -1);
   Iso3 Tcp(int robot, const JointVector& q) const {
     const TaskRobot& r = w_.robots[robot];
     return TcpPose(r.chain, r.X_WB, q, r.end_effector.X_FT);
@@ -200,9 +199,9 @@ class Builder {
   PlanState state_;
   std::vector<JointVector> cur_;
   std::vector<double> opening_;
-  std::vector<int> released_;  // per robot: object let go at its last event, not yet backed off
+  std::vector<int> released_;     // per robot: object let go at its last event, not yet backed off
   std::vector<int> released_at_;  // per robot: the action of that event
-  std::set<int> grounded_;     // objects touching the table top
+  std::set<int> grounded_;        // objects touching the table top
   std::vector<GeoSegment> out_;
   int free_index_ = 0;
   bool cancelled_ = false;
@@ -650,12 +649,14 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
     std::string hit;
     if (std::getenv("WRAP_MOTION_DEBUG") && !answer.solved && !answer.timed_out) {
       const bool at_start = answer.why.find("start") != std::string::npos;
-      for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], at_start ? cur_[who[i]] : to[i]);
+      for (size_t i = 0; i < who.size(); ++i)
+        scene_.SetRobot(who[i], at_start ? cur_[who[i]] : to[i]);
       CollisionResult res;
       if (scene_.cell().InCollision(&res)) hit = " (" + scene_.cell().Describe(res.first) + ")";
       if (at_start) {
         for (int r : who) {
-          std::fprintf(stderr, "[free] start of %s: opening %.4f, holds %d; keyframes:", Name(r).c_str(),
+          std::fprintf(stderr,
+                       "[free] start of %s: opening %.4f, holds %d; keyframes:", Name(r).c_str(),
                        opening_[r], state_.held[r]);
           for (int j = std::max(0, action - 3); j <= action; ++j) {
             std::fprintf(stderr, " %d:%s", j + 1,
@@ -871,12 +872,12 @@ bool Builder::Carry(int action, int node, const std::vector<int>& holders, const
     double carry_length = 0.0;
     std::string search_why;
     if (!SetScene(opening_)) return false;
-    auto path = CarrySearch(holders, X_start, X_goal, goal_q, target, rebranch, &carry_length,
-                            search_why);
+    auto path =
+        CarrySearch(holders, X_start, X_goal, goal_q, target, rebranch, &carry_length, search_why);
     if (!path.empty()) {
       for (const auto& [i, q] : rebranch) Rebranch(holders[i], action, approach, goal_q[i], q);
-      PushSkill(SegmentKind::kCarry, action, true, holders, {node}, std::move(path),
-                carry_length, opt_.carry_speed_mps);
+      PushSkill(SegmentKind::kCarry, action, true, holders, {node}, std::move(path), carry_length,
+                opt_.carry_speed_mps);
       return true;
     }
     why += "; searched over the object's poses: " + search_why;
@@ -969,7 +970,7 @@ std::vector<std::vector<JointVector>> Builder::CarrySearch(
   const double budget_s = opt_.segment_time_s * std::pow(2.0, effort_);  // thread CPU time
   const double cpu0 = ThreadCpuSeconds();
   const auto t0 = std::chrono::steady_clock::now();
-  constexpr double kStepM = 0.08;      // longest edge in the metric [m]
+  constexpr double kStepM = 0.08;  // longest edge in the metric [m]
   constexpr int kMaxNodes = 4000;
   int goal_node = -1;
   std::vector<JointVector> goal_last;

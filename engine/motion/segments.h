@@ -68,7 +68,7 @@ struct GeoSegment {
 
 /// Why the geometric motion of a plan could not be made.
 struct MotionFailure {
-  int action = -1;       ///< Action of the segment.
+  int action = -1;  ///< Action of the segment.
   /// The action whose keyframe made it fail (the task plan's edge to avoid): the segment's own,
   /// or, for a retreat, the action that let go.
   int blame = -1;

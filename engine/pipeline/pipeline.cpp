@@ -26,7 +26,7 @@ struct Candidate {
   Plan plan;
   MotionCache cache;
   int effort = 0;
-  int order = 0;  // arrival
+  int order = 0;            // arrival
   std::uint64_t stuck = 0;  // edge of the action where its motion was last suspended
 };
 
@@ -45,7 +45,8 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
   // A solved plan carries each gripper's utilisation per action (for the GUI and reports); a
   // failure to compute it leaves the plan as it is.
   auto annotate = [&](Plan& plan) {
-    if (plan.stats.solved) (void)AnnotateUtilisation(project, check, plan, options.task.project_file);
+    if (plan.stats.solved)
+      (void)AnnotateUtilisation(project, check, plan, options.task.project_file);
   };
   auto first = PlanTask(project, check, pre, options.task, ctx);
   if (!first) return first;

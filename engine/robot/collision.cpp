@@ -77,7 +77,8 @@ class MeshTreeCache {
     auto model = std::make_shared<Tree>();
     if (model->beginModel(static_cast<int>(triangles.size()), static_cast<int>(vertices.size())) !=
             fcl::BVH_OK ||
-        model->addSubModel(vertices, triangles) != fcl::BVH_OK || model->endModel() != fcl::BVH_OK) {
+        model->addSubModel(vertices, triangles) != fcl::BVH_OK ||
+        model->endModel() != fcl::BVH_OK) {
       return nullptr;
     }
     model->computeLocalAABB();
@@ -611,7 +612,8 @@ struct CollisionWorld::Impl {
       order[m] = v;
     }
     const double margin = request.margin_m;
-    if (clean.size() != bodies.size() * bodies.size()) clean.assign(bodies.size() * bodies.size(), 0);
+    if (clean.size() != bodies.size() * bodies.size())
+      clean.assign(bodies.size() * bodies.size(), 0);
     bool hit = false;
     for (std::size_t ii = 0; ii < order.size(); ++ii) {
       const int i = order[ii];

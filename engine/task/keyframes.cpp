@@ -1007,9 +1007,9 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
         std::string why_straight;
         for (size_t i = 0; i < movers.size(); ++i) {
           const int r = movers[i].robot;
-          const bool grasps = (r == a.r1 && (a.type == ActionType::kPick ||
-                                             a.type == ActionType::kAddGrasp)) ||
-                              (r == a.r2 && a.type == ActionType::kHandover);
+          const bool grasps =
+              (r == a.r1 && (a.type == ActionType::kPick || a.type == ActionType::kAddGrasp)) ||
+              (r == a.r2 && a.type == ActionType::kHandover);
           if (!grasps) continue;
           const TaskRobot& R = world_.robots[r];
           const Vec3 back = -TcpPose(R.chain, R.X_WB, q[i], R.end_effector.X_FT).linear().col(2);

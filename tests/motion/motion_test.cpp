@@ -397,8 +397,7 @@ TEST_F(Handmade, TrapezoidTimesMatchHandComputedOnes) {
   GeoSegment skill;
   skill.kind = SegmentKind::kApproach;
   skill.robots = {0};
-  const JointVector q1 =
-      plan.initial.q[0] + 0.01 * JointVector::Unit(plan.initial.q[0].size(), 5);
+  const JointVector q1 = plan.initial.q[0] + 0.01 * JointVector::Unit(plan.initial.q[0].size(), 5);
   skill.waypoints = {{plan.initial.q[0]}, {q1}};
   skill.skill_length_m = 0.04;
   skill.skill_speed_mps = 0.05;
@@ -415,8 +414,7 @@ TEST_F(Handmade, IndependentRobotsOverlapAndSharedOnesWait) {
     GeoSegment seg;
     seg.kind = SegmentKind::kFree;
     seg.robots = {r};
-    const JointVector q1 =
-        plan.initial.q[r] + 0.3 * JointVector::Unit(plan.initial.q[r].size(), 0);
+    const JointVector q1 = plan.initial.q[r] + 0.3 * JointVector::Unit(plan.initial.q[r].size(), 0);
     seg.waypoints = {{plan.initial.q[r]}, {q1}, {plan.initial.q[r]}};
     seg.openings.assign(plan.robots.size(), -1.0);
     seg.sweep = {{box, box}};

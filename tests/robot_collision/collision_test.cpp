@@ -242,8 +242,7 @@ TEST(CollisionWorld, PairsFoundApartAreRetestedWhenABodyMoves) {
   const BodyId a = Add(w, "a", 0, {MeshShape(BoxMesh({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}))});
   // b turned 45 degrees next to a's corner: their boxes overlap, the cubes are 4 cm apart.
   const Iso3 apart = Pose({0.2, 0.2, 0}, {0, 0, std::numbers::pi / 4});
-  const BodyId b =
-      Add(w, "b", 1, {MeshShape(BoxMesh({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}))}, apart);
+  const BodyId b = Add(w, "b", 1, {MeshShape(BoxMesh({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}))}, apart);
   EXPECT_FALSE(w.AnyCollision());
   EXPECT_FALSE(w.AnyCollision());
   w.SetPose(b, apart);  // the same pose: nothing moved

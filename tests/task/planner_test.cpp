@@ -93,9 +93,9 @@ TEST(KeyframeSolver, StraightMovesAreCheckedAtTheKeyframe) {
     a.type = ActionType::kPick;
     a.r1 = robot;
     a.obj = leg;
-    a.grasp = rig.tables.Grasp(leg, static_cast<int>(i),
-                               GraspRef{leg, static_cast<int>(i), g.part, g.X_PG, g.width_m,
-                                        g.quality});
+    a.grasp =
+        rig.tables.Grasp(leg, static_cast<int>(i),
+                         GraspRef{leg, static_cast<int>(i), g.part, g.X_PG, g.width_m, g.quality});
     SymState next = s;
     next.held[robot] = leg;
     next.grasp[robot] = a.grasp;
