@@ -271,6 +271,8 @@ Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
   for (int i = 0; i < n_actions; ++i) {
     if (!std::isfinite(out.action_start_s[i])) out.action_start_s[i] = out.action_end_s[i];
   }
+  out.segment_start_s = start;
+  out.segment_end_s = end;
   return out;
 }
 

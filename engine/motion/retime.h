@@ -23,9 +23,11 @@ struct Timing {
   std::vector<MotionSegment> segments;        ///< The segments with their times, by start.
   std::vector<double> action_start_s;         ///< Per action: first motion toward it [s].
   std::vector<double> action_end_s;           ///< Per action: its keyframe moment [s].
-  double makespan_s = 0.0;                    ///< Everything done, robots moving concurrently.
-  double makespan_sequential_s = 0.0;         ///< Same segments one at a time.
-  int dependencies = 0;                       ///< Ordering constraints the schedule kept.
+  /// Per input segment (the order of `segments` given to Retime): its start and end [s].
+  std::vector<double> segment_start_s, segment_end_s;
+  double makespan_s = 0.0;             ///< Everything done, robots moving concurrently.
+  double makespan_sequential_s = 0.0;  ///< Same segments one at a time.
+  int dependencies = 0;                ///< Ordering constraints the schedule kept.
 };
 
 /// Times the geometric motion `segments` of `plan` (from PlanGeometricMotion). Fails with

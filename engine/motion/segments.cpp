@@ -126,6 +126,18 @@ class Builder {
   // robot's joints, the objects' poses, the holds, grasps and finger openings.
   std::vector<double> SceneKey() const;
   bool Retreat(int action, int robot);
+  // The weight of an object that robot `robot` holds alone, as its gripper takes it.
+  struct Load {
+    int robot = -1;
+    double mass = 0.0;
+    Vec3 com_A = Vec3::Zero();     // centre of mass in the assembly frame
+    Iso3 X_GA = Iso3::Identity();  // assembly frame in the grasp (TCP) frame
+    WrenchBox box;                 // the gripper's limits while carrying
+  };
+  // The loads of the robots of `robots` that carry an object alone (state_).
+  std::vector<Load> SoleLoads(const std::vector<int>& robots) const;
+  // Largest ratio of a component of the load's wrench (grasp frame) to its limit at joints q.
+  double LoadRatio(const Load& load, const JointVector& q) const;
   // Sets robot's finger opening for a free move toward a grasp: `wanted`, unless the fingers at
   // `wanted` hit something where the robot stands and at their present opening do not (then
   // they stay). False when the scene cannot be set.
@@ -508,6 +520,45 @@ std::vector<JointVector> Builder::BackOff(int robot, const JointVector& q, doubl
   return {};
 }
 
+std::vector<Builder::Load> Builder::SoleLoads(const std::vector<int>& robots) const {
+  std::vector<Load> out;
+  for (int r : robots) {
+    const int node = state_.held[r];
+    if (node < 0 || state_.Holders(node).size() != 1) continue;
+    Load l;
+    l.robot = r;
+    for (int p : w_.tree->nodes[node].parts) {
+      l.mass += w_.part_mass[p];
+      l.com_A += w_.part_mass[p] * w_.part_com_A[p];
+    }
+    if (!(l.mass > 0.0)) continue;
+    l.com_A /= l.mass;
+    const PlanGrasp& g = state_.grasp[r];
+    l.X_GA = (w_.X_AP[g.part] * g.X_PG).inverse();
+    const TaskRobot& tr = w_.robots[r];
+    l.box = tr.end_effector.kind == EndEffectorKind::kVacuum ? tr.limits.vacuum_transport
+                                                             : tr.limits.two_finger;
+    out.push_back(l);
+  }
+  return out;
+}
+
+double Builder::LoadRatio(const Load& load, const JointVector& q) const {
+  constexpr double kG = 9.81;
+  const Iso3 X_WG = Tcp(load.robot, q);
+  const Mat3 R_GW = X_WG.linear().transpose();
+  // Gravity on the object, and its moment about the grasp point, in the grasp frame.
+  const Vec3 f_G = R_GW * Vec3(0.0, 0.0, -load.mass * kG);
+  const Vec3 c_G = load.X_GA * load.com_A;
+  const Vec3 tau_G = c_G.cross(f_G);
+  double u = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    u = std::max(u, std::abs(f_G[i]) / std::max(load.box.force_N[i], 1e-9));
+    u = std::max(u, std::abs(tau_G[i]) / std::max(load.box.torque_Nm[i], 1e-9));
+  }
+  return u;
+}
+
 bool Builder::MoveOpening(int robot, double wanted) {
   const double now = opening_[robot];
   opening_[robot] = wanted;
@@ -588,6 +639,7 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
       if (reached) *reached = end;
       seg.robots = c.robots;
       seg.waypoints = c.waypoints;
+      seg.free_index = index;
       Push(std::move(seg));
       return true;
     }
@@ -633,14 +685,37 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
       }
       return qs;
     };
+    // Objects carried by one robot: their weight on the gripper stays within the limits' share
+    // (or the worse of the two ends' loads).
+    const std::vector<Load> loads = SoleLoads(who);
+    std::vector<std::pair<size_t, double>> load_bound;  // (index in who, largest ratio)
+    for (const Load& load : loads) {
+      const size_t i =
+          static_cast<size_t>(std::find(who.begin(), who.end(), load.robot) - who.begin());
+      load_bound.push_back({i, std::max({opt_.transport_load_max, LoadRatio(load, cur_[who[i]]),
+                                         LoadRatio(load, to[i])}) +
+                                   1e-9});
+    }
+    if (std::getenv("WRAP_MOTION_DEBUG")) {
+      for (size_t l = 0; l < loads.size(); ++l) {
+        std::fprintf(stderr, "[load] action %d %s: up to %.2f of its limits\n", action + 1,
+                     Name(loads[l].robot).c_str(), load_bound[l].second);
+      }
+    }
     query.valid = [&](const Eigen::VectorXd& x) {
       const std::vector<JointVector> qs = split(x);
+      for (size_t l = 0; l < loads.size(); ++l) {
+        if (LoadRatio(loads[l], qs[load_bound[l].first]) > load_bound[l].second) return false;
+      }
       for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], qs[i]);
       return !scene_.Collides(who);
     };
     query.resolution = opt_.resolution_rad;
     query.time_limit_s = opt_.segment_time_s * std::pow(2.0, effort_);
     query.seed = Mix(seed_, static_cast<std::uint64_t>(index) * 2 + (who.size() > movers.size()));
+    if (auto it = cache_.reseed.find(index); it != cache_.reseed.end()) {
+      query.seed = Mix(query.seed, 0x7265736565640000ULL + static_cast<std::uint64_t>(it->second));
+    }
     query.stop = [this] { return ctx_.ShouldStop(); };
     query.shortcut_attempts = opt_.shortcut_attempts;
     const auto t_query = std::chrono::steady_clock::now();
@@ -753,6 +828,7 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
   }
   seg.robots = who;
   seg.waypoints = std::move(path);
+  seg.free_index = index;
   cache_.free_paths[index] = {seg.robots, seg.waypoints, scene_key};
   Push(std::move(seg));
   return true;

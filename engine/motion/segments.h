@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -42,6 +43,12 @@ struct MotionOptions {
   double grip_s = 0.4;              ///< A gripper closing or opening at a keyframe [s].
   /// Shortcut attempts per free path.
   int shortcut_attempts = 16;
+  /// Along a free path, an object held by one robot may load its gripper (its weight, in the
+  /// grasp frame, against the transport box of a vacuum cup or the two-finger box) up to this
+  /// fraction of the limits, or up to the path's ends' load where that is higher: the task plan's
+  /// wrench gates hold at the keyframes only, and an object turned on the way (a seat held by
+  /// its edge) can hang on its gripper beyond the limits; the rest is kept for the accelerations.
+  double transport_load_max = 0.8;
   /// Run the independent trajectory check on the timed result; a plan that fails it has no
   /// motion (its first issue is the failure), so no colliding trajectory leaves the planner.
   bool self_check = true;
@@ -60,6 +67,7 @@ struct GeoSegment {
   double skill_length_m = 0.0;   ///< Cartesian length of a skill (sets its duration) [m].
   double skill_speed_mps = 0.0;  ///< Its TCP or object speed [m/s]; 0 for free paths.
   double hold_s = 0.0;           ///< Grip: how long the robots stay [s].
+  int free_index = -1;           ///< A free path: its index in MotionCache::free_paths.
   /// World boxes swept by its robots' bodies and what they carry, and of its objects, grown by
   /// the sampling bound, per body: [0] the whole sweep, then the sweeps of consecutive runs of
   /// samples. Two segments whose boxes do not meet can run at the same time.
@@ -87,6 +95,9 @@ struct MotionCache {
     std::vector<double> scene;
   };
   std::vector<Path> free_paths;  ///< By free segment index.
+  /// Free paths to search again with another seed (free segment index -> how many times): the
+  /// timed result grazed something between the path's checked states (see PlanMotion).
+  std::map<int, int> reseed;
 };
 
 /// The geometric motion of `plan` at effort level `effort`. Keyframes stay, except where a straight

@@ -735,8 +735,11 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
         return above_table(o, X[o]);
       };
       gates = [&](const std::vector<Iso3>& X, Gate& g, std::string& why) {
+        // The giver brings it there alone; the receiver holds it alone afterwards.
+        const WrenchObject giver{o, X[o], false, {{a.r1, s.grasp[a.r1]}}};
         const WrenchObject obj{o, X[o], false, {{a.r2, a.grasp}}};
-        if (!Wrench(WrenchGate::kTransport, {&obj, 1}, -1, 0, &why)) {
+        if (!Wrench(WrenchGate::kTransport, {&giver, 1}, -1, 0, &why) ||
+            !Wrench(WrenchGate::kTransport, {&obj, 1}, -1, 0, &why)) {
           g = Gate::kWrenchTransport;
           return false;
         }
@@ -764,6 +767,14 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
         return above_table(o, X[o]);
       };
       gates = [&, holders, resting](const std::vector<Iso3>& X, Gate& g, std::string& why) {
+        // In the air its holders bring it there before the new hand takes it.
+        if (!resting) {
+          const WrenchObject before{o, X[o], false, holders};
+          if (!Wrench(WrenchGate::kTransport, {&before, 1}, -1, 0, &why)) {
+            g = Gate::kWrenchTransport;
+            return false;
+          }
+        }
         WrenchObject obj{o, X[o], resting, holders};
         obj.holders.push_back({a.r1, a.grasp});
         if (!Wrench(WrenchGate::kRelease, {&obj, 1}, -1, 0, &why)) {
@@ -833,6 +844,15 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
       };
       gates = [&, m_holders, b_holders, b_rests, M, B](const std::vector<Iso3>& X, Gate& g,
                                                        std::string& why) {
+        // Each input is brought to the mating pose by its own holders, alone: the base in the
+        // air, the moved input (oriented as at its approach).
+        const WrenchObject m_alone{M, X[M], false, m_holders};
+        const WrenchObject b_alone{B, X[B], false, b_holders};
+        if ((!m_holders.empty() && !Wrench(WrenchGate::kTransport, {&m_alone, 1}, -1, 0, &why)) ||
+            (!b_rests && !Wrench(WrenchGate::kTransport, {&b_alone, 1}, -1, 0, &why))) {
+          g = Gate::kWrenchTransport;
+          return false;
+        }
         const WrenchObject objs[2] = {{M, X[M], keyframe_resting[M], m_holders},
                                       {B, X[B], b_rests, b_holders}};
         std::uint64_t key = 0;

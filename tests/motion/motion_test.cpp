@@ -18,6 +18,7 @@
 #include "motion/motion.h"
 #include "motion/ompl_adapter.h"
 #include "motion/retime.h"
+#include "motion/scene.h"
 #include "motion/trajectory_check.h"
 #include "motion_fixture.h"
 #include "pipeline/pipeline.h"
@@ -215,6 +216,59 @@ TEST_P(ExampleMotion, TrajectoriesPassTheIndependentChecks) {
     EXPECT_LT((plan.trajectories[r].knots.back().q - plan.initial.q[r]).cwiseAbs().maxCoeff(),
               1e-9);
   }
+  // Along a free path an object carried by one robot loads its gripper (its weight in the grasp
+  // frame against the gripper's box: a vacuum cup's transport limits, the two-finger limits) no
+  // more than 80% of the limits, or than the path's ends do where that is more.
+  const TaskWorld& w = *p.world;
+  const std::vector<PlanState> states = ReplayPlanStates(plan);
+  int loaded = 0;
+  for (const MotionSegment& m : plan.segments) {
+    if (m.kind != "free" || m.action < 0 || m.action + 1 >= static_cast<int>(states.size())) {
+      continue;
+    }
+    // Before its action, or after it (the robots' way home at the end).
+    const bool after = m.start_s >= plan.actions[m.action].end_s - 1e-9;
+    const PlanState& st = states[m.action + (after ? 1 : 0)];
+    for (int r : m.robots) {
+      const int node = st.held[r];
+      if (node < 0 || st.Holders(node).size() != 1) continue;
+      double mass = 0.0;
+      Vec3 com_A = Vec3::Zero();
+      for (int part : w.tree->nodes[node].parts) {
+        mass += w.part_mass[part];
+        com_A += w.part_mass[part] * w.part_com_A[part];
+      }
+      com_A /= mass;
+      const PlanGrasp& g = st.grasp[r];
+      const Iso3 X_AG = w.X_AP[g.part] * g.X_PG;
+      const TaskRobot& robot = w.robots[r];
+      const WrenchBox& box = robot.end_effector.kind == EndEffectorKind::kVacuum
+                                 ? robot.limits.vacuum_transport
+                                 : robot.limits.two_finger;
+      auto ratio = [&](double t) {
+        const JointVector q = SampleTrajectory(plan.trajectories[r], t);
+        const Iso3 X_WG = TcpPose(robot.chain, robot.X_WB, q, robot.end_effector.X_FT);
+        const Vec3 f = X_WG.linear().transpose() * Vec3(0, 0, -9.81 * mass);
+        const Vec3 tau = (X_AG.inverse() * com_A).cross(f);
+        double u = 0.0;
+        for (int i = 0; i < 3; ++i) {
+          u = std::max({u, std::abs(f[i]) / box.force_N[i], std::abs(tau[i]) / box.torque_Nm[i]});
+        }
+        return u;
+      };
+      const double bound = std::max({0.8, ratio(m.start_s), ratio(m.end_s)}) + 1e-6;
+      for (int k = 0; k <= 40; ++k) {
+        const double t = m.start_s + (m.end_s - m.start_s) * k / 40.0;
+        EXPECT_LE(ratio(t), bound) << "robot " << plan.robots[r] << " at t = " << t
+                                   << " in the free segment of action " << m.action + 1;
+      }
+      ++loaded;
+    }
+  }
+  if (GetParam() == "stool") {
+    EXPECT_GT(loaded, 0);  // (it carries parts along free paths)
+  }
+
   // Skills are marked with their own durations.
   int skills = 0;
   for (const MotionSegment& m : plan.segments) skills += m.kind != "free" && m.kind != "grip";
@@ -257,6 +311,50 @@ TEST(Motion, SameSeedSameTrajectories) {
 
 // Paths searched at a resolution far too coarse step through obstacles; the independent check
 // inside PlanMotion refuses them, so no colliding trajectory leaves the planner.
+// A free path marked for another seed (what PlanMotion does when the timed result grazes
+// something inside it) is searched again and comes out different; the rest comes from the cache
+// and the result still passes the check.
+TEST(Motion, FreePathsMarkedForAnotherSeedAreSearchedAgain) {
+  const Planned& p = PlanOnce("stool");
+  ASSERT_TRUE(p.error.empty() && p.plan->stats.solved);
+  auto strip = [](Plan plan) {
+    plan.trajectories.clear();
+    plan.segments.clear();
+    for (PlanAction& a : plan.actions) a.start_s = a.end_s = -1.0;
+    return plan;
+  };
+  Plan first = strip(*p.plan);
+  MotionCache cache;
+  RunContext ctx(1);
+  auto a = PlanMotion(*p.world, first, MotionOptions{}, 1, 5, cache, ctx);
+  ASSERT_TRUE(a && a->solved);
+  // The searched (not straight) free paths, marked; their cached paths forgotten.
+  std::vector<std::vector<std::vector<JointVector>>> before(cache.free_paths.size());
+  int marked = 0;
+  for (size_t k = 0; k < cache.free_paths.size(); ++k) {
+    before[k] = cache.free_paths[k].waypoints;
+    if (before[k].size() > 2) {
+      cache.reseed[static_cast<int>(k)] = 1;
+      cache.free_paths[k].waypoints.clear();
+      ++marked;
+    }
+  }
+  ASSERT_GT(marked, 0);
+  Plan again = strip(*p.plan);
+  auto b = PlanMotion(*p.world, again, MotionOptions{}, 1, 5, cache, ctx);
+  ASSERT_TRUE(b && b->solved) << (b ? b->failure.message : b.error().message);
+  int differ = 0;
+  for (size_t k = 0; k < before.size() && k < cache.free_paths.size(); ++k) {
+    if (cache.reseed.contains(static_cast<int>(k)) && cache.free_paths[k].waypoints != before[k]) {
+      ++differ;
+    }
+  }
+  EXPECT_GT(differ, 0);
+  auto check = CheckTrajectories(*p.world, again, {});
+  ASSERT_TRUE(check);
+  EXPECT_TRUE(check->valid);
+}
+
 TEST(Motion, TheSelfCheckRefusesTrajectoriesThatCollide) {
   const Planned& p = PlanOnce("half_stool");
   ASSERT_TRUE(p.error.empty()) << p.error;
