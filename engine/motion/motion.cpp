@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
 #include "motion/retime.h"
+#include "motion/scene.h"
 #include "motion/trajectory_check.h"
 #include "task/plan_json.h"
 
@@ -16,6 +18,75 @@ namespace {
 double Since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
+// The load that an object carried by one robot puts on its gripper along timed segment `g`
+// (start t0, end t1): gravity and the object's inertia (its centre of mass's acceleration from
+// the trajectory; its rotational inertia neglected), in the grasp frame, against the gripper's
+// box (a vacuum cup's transport limits, the two-finger limits). Kept per sample, weight and
+// inertia apart, so that the load of the same path run slower can be told without sampling it
+// again: Peak(s) is the largest ratio of a component to its limit with the accelerations
+// scaled by s (a path run k times slower: s = 1 / k^2), 0 when no object is carried alone.
+class CarryLoad {
+ public:
+  CarryLoad(const TaskWorld& world, const Plan& plan, const std::vector<PlanState>& states,
+            const std::vector<double>& action_end_s, const GeoSegment& g, double t0, double t1) {
+    if (g.action < 0 || g.action >= static_cast<int>(action_end_s.size()) || !(t1 > t0)) return;
+    // Before its action, or after it (the robots' way home at the end).
+    const bool after = t0 >= action_end_s[g.action] - 1e-9;
+    const PlanState& st = states[static_cast<size_t>(g.action) + (after ? 1 : 0)];
+    for (int r : g.robots) {
+      const int node = st.held[r];
+      if (node < 0 || st.Holders(node).size() != 1) continue;
+      double mass = 0.0;
+      Vec3 com_A = Vec3::Zero();
+      for (int p : world.tree->nodes[node].parts) {
+        mass += world.part_mass[p];
+        com_A += world.part_mass[p] * world.part_com_A[p];
+      }
+      if (!(mass > 0.0)) continue;
+      com_A /= mass;
+      const PlanGrasp& grasp = st.grasp[r];
+      const Vec3 com_G = (world.X_AP[grasp.part] * grasp.X_PG).inverse() * com_A;
+      const TaskRobot& robot = world.robots[r];
+      const WrenchBox& box = robot.end_effector.kind == EndEffectorKind::kVacuum
+                                 ? robot.limits.vacuum_transport
+                                 : robot.limits.two_finger;
+      auto X_WG = [&](double t) {
+        return TcpPose(robot.chain, robot.X_WB, SampleTrajectory(plan.trajectories[r], t),
+                       robot.end_effector.X_FT);
+      };
+      constexpr double h = 0.002;  // [s]
+      const int n = std::max(8, static_cast<int>(std::ceil((t1 - t0) / 0.02)));
+      for (int k = 0; k <= n; ++k) {
+        const double t = std::clamp(t0 + (t1 - t0) * k / n, t0 + h, t1 - h);
+        const Iso3 X = X_WG(t);
+        const Vec3 a = (X_WG(t + h) * com_G - 2.0 * (X * com_G) + X_WG(t - h) * com_G) / (h * h);
+        // What the gripper applies on the object, in the grasp frame.
+        samples_.push_back({X.linear().transpose() * (mass * Vec3(0.0, 0.0, 9.81)),
+                            X.linear().transpose() * (mass * a), com_G, &box});
+      }
+    }
+  }
+  double Peak(double accel_scale) const {
+    double peak = 0.0;
+    for (const Sample& s : samples_) {
+      const Vec3 f = s.weight + accel_scale * s.inertia;
+      const Vec3 tau = s.com_G.cross(f);
+      for (int i = 0; i < 3; ++i) {
+        peak = std::max({peak, std::abs(f[i]) / std::max(s.box->force_N[i], 1e-9),
+                         std::abs(tau[i]) / std::max(s.box->torque_Nm[i], 1e-9)});
+      }
+    }
+    return peak;
+  }
+
+ private:
+  struct Sample {
+    Vec3 weight, inertia, com_G;
+    const WrenchBox* box;
+  };
+  std::vector<Sample> samples_;
+};
+
 }  // namespace
 
 Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const MotionOptions& options,
@@ -24,6 +95,11 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
   // Times a free path is searched again with another seed when the timed result grazes
   // something inside it (a contact narrower than the path search's step: see below).
   constexpr int kMaxRepairs = 3;
+  // An object carried by one robot loads its gripper at most this fraction of the limits, weight
+  // and inertia together (MuJoCo's welds see the same), by slowing its segments down, at most
+  // kMaxSlow times.
+  constexpr double kMaxLoad = 0.9;
+  constexpr double kMaxSlow = 6.0;
   MotionAttempt out;
   const std::vector<PlanAction> original = plan.actions;
   for (int repair = 0;; ++repair) {
@@ -41,6 +117,41 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
     t0 = std::chrono::steady_clock::now();
     plan.actions = std::move(work.actions);
     auto timing = Retime(world, plan, *segments);
+    // Where an object carried by one robot would load its gripper beyond kMaxLoad with its
+    // weight and inertia, that segment runs slower (the inertial part falls with the square of
+    // the time stretch), and the schedule is made again.
+    const std::vector<PlanState> states = ReplayPlanStates(plan);
+    for (int round = 0; round < 4 && timing; ++round) {
+      bool slowed = false;
+      plan.trajectories = timing->trajectories;
+      for (size_t j = 0; j < segments->size(); ++j) {
+        GeoSegment& g = (*segments)[j];
+        if (g.kind == SegmentKind::kGrip) continue;
+        const CarryLoad load(world, plan, states, timing->action_end_s, g,
+                             timing->segment_start_s[j], timing->segment_end_s[j]);
+        const double peak = load.Peak(1.0);
+        if (peak <= kMaxLoad) continue;
+        // The least slow-down that brings it within kMaxLoad, or (where the weight alone comes
+        // near) within a little of the weight's own load, in steps of 10%.
+        const double target = std::max(kMaxLoad, load.Peak(0.0) + 0.03);
+        const double f = timing->segment_stretch[j];
+        double k = 1.0;
+        while (f * k < kMaxSlow && load.Peak(1.0 / (k * k)) > target) k *= 1.1;
+        k = std::min(k, kMaxSlow / f);
+        if (std::getenv("WRAP_MOTION_DEBUG")) {
+          std::fprintf(
+              stderr,
+              "[load] segment %zu (%s, action %d): peak %.2f (weight %.2f), %.2f x slower: %.2f\n",
+              j, std::string(ToString(g.kind)).c_str(), g.action + 1, peak, load.Peak(0.0), f * k,
+              load.Peak(1.0 / (k * k)));
+        }
+        if (k <= 1.0 + 1e-9) continue;
+        g.slow = f * k;
+        slowed = true;
+      }
+      if (!slowed) break;
+      timing = Retime(world, plan, *segments);
+    }
     const double t_retime = Since(t0);
     out.t_retime_s += t_retime;
     ctx.AddTime("retime", t_retime);

@@ -62,6 +62,7 @@ bool SweepsMeet(const std::vector<std::vector<Aabb>>& a, const std::vector<std::
 // A segment's motion as knots relative to its start: per knot the time, and per robot q, qd.
 struct TimedSegment {
   double duration = 0.0;
+  double stretch = 1.0;  // how much slower than its fastest timing
   std::vector<double> t;
   std::vector<std::vector<JointVector>> q;   // q[k][i]
   std::vector<std::vector<JointVector>> qd;  // qd[k][i]
@@ -108,6 +109,8 @@ TimedSegment TimeSegment(const TaskWorld& world, const GeoSegment& seg) {
   if (seg.skill_speed_mps > 0.0 && total > 0.0) {
     f = std::max(1.0, seg.skill_length_m / seg.skill_speed_mps / total);
   }
+  f = std::max(f, seg.slow);
+  out.stretch = f;
   double t0 = 0.0;
   for (size_t k = 1; k < seg.waypoints.size(); ++k) {
     Profile p = pieces[k - 1];
@@ -273,6 +276,7 @@ Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
   }
   out.segment_start_s = start;
   out.segment_end_s = end;
+  for (const TimedSegment& ts : timed) out.segment_stretch.push_back(ts.stretch);
   return out;
 }
 

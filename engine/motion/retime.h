@@ -25,6 +25,8 @@ struct Timing {
   std::vector<double> action_end_s;           ///< Per action: its keyframe moment [s].
   /// Per input segment (the order of `segments` given to Retime): its start and end [s].
   std::vector<double> segment_start_s, segment_end_s;
+  /// Per input segment: how much slower than its fastest timing it runs (skill speed, slow).
+  std::vector<double> segment_stretch;
   double makespan_s = 0.0;             ///< Everything done, robots moving concurrently.
   double makespan_sequential_s = 0.0;  ///< Same segments one at a time.
   int dependencies = 0;                ///< Ordering constraints the schedule kept.

@@ -87,6 +87,12 @@ class Builder {
       const std::vector<int>& robots, const std::vector<JointVector>& q0,
       const std::vector<std::function<Iso3(double)>>& targets, int steps,
       const std::vector<JointVector>* goals = nullptr);
+  // The fewest of `path`'s samples (the first and the last kept) between which straight joint
+  // motion stays within a fraction of a millimetre of every dropped sample's TCP pose: a skill
+  // is timed piece by piece, each piece from rest to rest, so a line tracked at millimetres
+  // would be driven in jerks (MuJoCo saw the load on a lifting gripper swing by +-30%).
+  std::vector<std::vector<JointVector>> Simplify(const std::vector<int>& robots,
+                                                 std::vector<std::vector<JointVector>> path) const;
   // Collision-free straight joint motion between consecutive waypoints (scene already set).
   bool PathClear(const std::vector<int>& robots,
                  const std::vector<std::vector<JointVector>>& waypoints);
@@ -409,6 +415,42 @@ std::vector<std::vector<JointVector>> Builder::Track(
       q = next;
       out[k][i] = q;
     }
+  }
+  return Simplify(robots, std::move(out));
+}
+
+std::vector<std::vector<JointVector>> Builder::Simplify(
+    const std::vector<int>& robots, std::vector<std::vector<JointVector>> path) const {
+  if (path.size() <= 2) return path;
+  // One arm may leave its Cartesian line by half a millimetre; arms that hold one object
+  // together by less, as they pull on it against each other.
+  const double tol_m = robots.size() > 1 ? 2e-4 : 5e-4;
+  const double tol_rad = robots.size() > 1 ? 2e-3 : 5e-3;
+  std::vector<std::vector<Iso3>> X(path.size(), std::vector<Iso3>(robots.size()));
+  for (size_t k = 0; k < path.size(); ++k) {
+    for (size_t i = 0; i < robots.size(); ++i) X[k][i] = Tcp(robots[i], path[k][i]);
+  }
+  // The straight joint motion from a to b passes within the tolerance of every sample between.
+  auto covers = [&](size_t a, size_t b) {
+    for (size_t m = a + 1; m < b; ++m) {
+      const double f = static_cast<double>(m - a) / static_cast<double>(b - a);
+      for (size_t i = 0; i < robots.size(); ++i) {
+        const Iso3 Xl = Tcp(robots[i], path[a][i] + f * (path[b][i] - path[a][i]));
+        if ((Xl.translation() - X[m][i].translation()).norm() > tol_m) return false;
+        if (Eigen::AngleAxisd(Xl.linear().transpose() * X[m][i].linear()).angle() > tol_rad) {
+          return false;
+        }
+      }
+    }
+    return true;
+  };
+  std::vector<std::vector<JointVector>> out = {path.front()};
+  size_t a = 0;
+  while (a + 1 < path.size()) {
+    size_t b = a + 1;
+    while (b + 1 < path.size() && covers(a, b + 1)) ++b;
+    out.push_back(path[b]);
+    a = b;
   }
   return out;
 }

@@ -68,6 +68,10 @@ struct GeoSegment {
   double skill_speed_mps = 0.0;  ///< Its TCP or object speed [m/s]; 0 for free paths.
   double hold_s = 0.0;           ///< Grip: how long the robots stay [s].
   int free_index = -1;           ///< A free path: its index in MotionCache::free_paths.
+  /// At least this much slower than the fastest timing its limits allow (times x slow,
+  /// velocities / slow, accelerations / slow^2): set where an object's inertia would load its
+  /// gripper beyond the limits (see PlanMotion).
+  double slow = 1.0;
   /// World boxes swept by its robots' bodies and what they carry, and of its objects, grown by
   /// the sampling bound, per body: [0] the whole sweep, then the sweeps of consecutive runs of
   /// samples. Two segments whose boxes do not meet can run at the same time.

@@ -717,6 +717,15 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
           g = Gate::kWrenchRest;
           return false;
         }
+        // Brought down to that pose by its holder alone (the same problem as a pick from it).
+        const WrenchObject carried{o, X[o], false, {{a.r1, s.grasp[a.r1]}}};
+        const std::uint64_t key =
+            HashMix(HashMix(HashMix(1, static_cast<std::uint64_t>(a.loc) + 100), a.r1),
+                    static_cast<std::uint64_t>(s.grasp[a.r1]));
+        if (!Wrench(WrenchGate::kTransport, {&carried, 1}, -1, key, &why)) {
+          g = Gate::kWrenchTransport;
+          return false;
+        }
         return true;
       };
       break;

@@ -23,7 +23,6 @@
 #include "robot/home.h"
 #include "robot/kinematics.h"
 #include "robot/project_chain.h"
-#include "robot/project_chain.h"
 
 namespace wrap {
 
@@ -957,6 +956,14 @@ void Validator::ReplayAction(int i) {
       std::vector<int> body(project_.parts.size(), -1);
       AddObject(o, X.at(o), {}, true, config, body);
       RunGate(i, WrenchGate::kRest, config, Quote(NodeName(o)) + " set down on the table");
+      if (obj.holders.size() == 1) {
+        // Carried down to the table by its holder alone.
+        StepConfiguration carried;
+        std::vector<int> carried_body(project_.parts.size(), -1);
+        AddObject(o, X.at(o), {obj.holders[0]}, false, carried, carried_body);
+        RunGate(i, WrenchGate::kTransport, carried,
+                Quote(RobotName(r)) + " carrying " + Quote(NodeName(o)) + " down to the table");
+      }
       for (const PlanHold& h : objects_[o].holders) {
         holding_[h.robot] = -1;
         freed_now_.insert(h.robot);

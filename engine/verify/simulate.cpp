@@ -22,7 +22,7 @@ namespace wrap {
 
 namespace {
 
-constexpr int kWeldRows = 6;  // a weld constrains 3 positions and 3 rotations
+constexpr int kWeldRows = 6;             // a weld constrains 3 positions and 3 rotations
 constexpr double kReleaseGrace_s = 0.5;  // a released object may touch its gripper this long
 
 double AngleOf(const Mat3& R) { return std::abs(Eigen::AngleAxisd(R).angle()); }
@@ -366,8 +366,11 @@ class Simulator {
       } else if (s.kind == "grip" || s.kind == "retreat") {
         windows_.push_back({s.start_s, s.end_s, s.robots, s.objects, false});
       } else if (s.kind == "insert" && s.objects.size() >= 2) {
-        windows_.push_back({s.start_s, std::max(s.end_s, end_s), plan_.actions[s.action].robots,
-                            {s.objects[0], s.objects[1]}, true});
+        windows_.push_back({s.start_s,
+                            std::max(s.end_s, end_s),
+                            plan_.actions[s.action].robots,
+                            {s.objects[0], s.objects[1]},
+                            true});
       }
     }
   }
@@ -401,8 +404,8 @@ class Simulator {
     }
     for (int p = 0; p < np; ++p) {
       for (int q = p + 1; q < np; ++q) {
-        rules.part_pair_ok[p][q] = node_of[p] == node_of[q] ||
-                                   (!rules.held[p] && !rules.held[q]) || loose[p] || loose[q];
+        rules.part_pair_ok[p][q] =
+            node_of[p] == node_of[q] || (!rules.held[p] && !rules.held[q]) || loose[p] || loose[q];
       }
     }
     const double slack = 2.0 * options_.sample_every * model_->opt.timestep;
@@ -509,10 +512,8 @@ class Simulator {
       detail = part_words(h.part_a, h.body_a) + " is " + Num(1000 * h.depth_m) +
                " mm into the table (tolerance " + tol + ")";
     } else {
-      const std::string a =
-          h.part_a >= 0 ? part_words(h.part_a, h.body_a) : "'" + h.body_a + "'";
-      const std::string b =
-          h.part_b >= 0 ? part_words(h.part_b, h.body_b) : "'" + h.body_b + "'";
+      const std::string a = h.part_a >= 0 ? part_words(h.part_a, h.body_a) : "'" + h.body_a + "'";
+      const std::string b = h.part_b >= 0 ? part_words(h.part_b, h.body_b) : "'" + h.body_b + "'";
       detail = a + " touches " + b + " deeper than the " + tol + " tolerance";
       if (h.robot_a >= 0 && h.robot_b >= 0) {
         detail += " (robot against robot)";
@@ -737,6 +738,10 @@ class Simulator {
             BoxUtilisation(f - hold_f_[r], tau - hold_tau_[r], lim.vacuum_assembly, fN, fNm));
       }
       was_inserting_[r] = insert_action >= 0;
+      if (const char* who = std::getenv("WRAP_SIM_TRACE"); who && scene_.robots[r].name == who) {
+        std::fprintf(stderr, "[sim] t %.4f %s u %.3f f %.2f %.2f %.2f tau %.3f %.3f %.3f\n", t, who,
+                     u, f.x(), f.y(), f.z(), tau.x(), tau.y(), tau.z());
+      }
       double& peak = vacuum ? (insert_action >= 0 ? report_.peak.vacuum_insertion
                                                   : report_.peak.vacuum_transport)
                             : (insert_action >= 0 ? report_.peak.two_finger_insertion
@@ -843,7 +848,8 @@ class Simulator {
       }
     }
     if (!report_.failure) CheckFinal(report_.simulated_s);
-    if (options_.on_frame) options_.on_frame(report_.simulated_s, CurrentState(report_.simulated_s));
+    if (options_.on_frame)
+      options_.on_frame(report_.simulated_s, CurrentState(report_.simulated_s));
     return {};
   }
 
@@ -861,10 +867,10 @@ class Simulator {
     std::vector<int> nodes;
     bool pair = false;  // the two nodes may touch each other too (an insertion)
   };
-  std::vector<Window> windows_;                       // contact windows, from the segments
-  std::optional<detail::SimCollisions> collisions_;   // when collisions are judged
-  bool collision_dirty_ = true;                       // an action happened since the last check
-  std::vector<JointVector> checked_q_;                // at the last collision check
+  std::vector<Window> windows_;                      // contact windows, from the segments
+  std::optional<detail::SimCollisions> collisions_;  // when collisions are judged
+  bool collision_dirty_ = true;                      // an action happened since the last check
+  std::vector<JointVector> checked_q_;               // at the last collision check
   std::vector<double> checked_openings_;
   std::vector<Iso3> checked_X_WP_;
 

@@ -269,10 +269,85 @@ TEST_P(ExampleMotion, TrajectoriesPassTheIndependentChecks) {
     EXPECT_GT(loaded, 0);  // (it carries parts along free paths)
   }
 
+  // With its inertia too (the centre of mass's acceleration along the timed trajectory, by
+  // central differences here): an object carried by one robot loads its gripper no more than
+  // 90% of the limits in any moving segment, or a little more than its weight alone does there
+  // (MuJoCo's welds feel both; sampled at other moments than the planner's, hence 0.03).
+  for (const MotionSegment& m : plan.segments) {
+    if (m.kind == "grip" || m.action < 0 || m.action + 1 >= static_cast<int>(states.size()) ||
+        !(m.end_s > m.start_s + 0.01)) {
+      continue;
+    }
+    const bool after = m.start_s >= plan.actions[m.action].end_s - 1e-9;
+    const PlanState& st = states[m.action + (after ? 1 : 0)];
+    for (int r : m.robots) {
+      const int node = st.held[r];
+      if (node < 0 || st.Holders(node).size() != 1) continue;
+      double mass = 0.0;
+      Vec3 com_A = Vec3::Zero();
+      for (int part : w.tree->nodes[node].parts) {
+        mass += w.part_mass[part];
+        com_A += w.part_mass[part] * w.part_com_A[part];
+      }
+      com_A /= mass;
+      const PlanGrasp& g = st.grasp[r];
+      const Vec3 com_G = (w.X_AP[g.part] * g.X_PG).inverse() * com_A;
+      const TaskRobot& robot = w.robots[r];
+      const WrenchBox& box = robot.end_effector.kind == EndEffectorKind::kVacuum
+                                 ? robot.limits.vacuum_transport
+                                 : robot.limits.two_finger;
+      auto X_WG = [&](double t) {
+        return TcpPose(robot.chain, robot.X_WB, SampleTrajectory(plan.trajectories[r], t),
+                       robot.end_effector.X_FT);
+      };
+      auto ratio = [&](double t, bool inertia) {
+        const double h = 0.001;
+        const Iso3 X = X_WG(t);
+        Vec3 a = Vec3::Zero();
+        if (inertia) a = (X_WG(t + h) * com_G - 2.0 * (X * com_G) + X_WG(t - h) * com_G) / (h * h);
+        const Vec3 f = X.linear().transpose() * (mass * (a + Vec3(0, 0, 9.81)));
+        const Vec3 tau = com_G.cross(f);
+        double u = 0.0;
+        for (int i = 0; i < 3; ++i) {
+          u = std::max({u, std::abs(f[i]) / box.force_N[i], std::abs(tau[i]) / box.torque_Nm[i]});
+        }
+        return u;
+      };
+      double weight = 0.0, total = 0.0, t_peak = m.start_s;
+      for (int k = 0; k <= 60; ++k) {
+        const double t = m.start_s + 0.002 + (m.end_s - m.start_s - 0.004) * k / 60.0;
+        weight = std::max(weight, ratio(t, false));
+        if (const double u = ratio(t, true); u > total) {
+          total = u;
+          t_peak = t;
+        }
+      }
+      EXPECT_LE(total, std::max(0.9, weight + 0.03) + 0.03)
+          << "robot " << plan.robots[r] << " at t = " << t_peak << " in the " << m.kind
+          << " segment of action " << m.action + 1 << " (weight alone " << weight << ")";
+    }
+  }
+
   // Skills are marked with their own durations.
   int skills = 0;
   for (const MotionSegment& m : plan.segments) skills += m.kind != "free" && m.kind != "grip";
   EXPECT_GT(skills, 0);
+  // A skill that moves a held object alone (a lift, a descent, an insertion) is driven in a few
+  // smooth pieces, not stop and go through its IK samples (every piece of a segment is timed
+  // from rest to rest, and each stop would jerk the object on its gripper): few moments inside
+  // it where a robot rests.
+  for (const MotionSegment& m : plan.segments) {
+    if (m.kind != "lift" && m.kind != "descend" && m.kind != "insert") continue;
+    for (int r : m.robots) {
+      int rests = 0;
+      for (const TrajectoryKnot& k : plan.trajectories[r].knots) {
+        rests +=
+            k.t > m.start_s + 1e-6 && k.t < m.end_s - 1e-6 && k.qd.cwiseAbs().maxCoeff() < 1e-9;
+      }
+      EXPECT_LE(rests, 4) << "robot " << plan.robots[r] << " in the " << m.kind
+                          << " segment of action " << m.action + 1;
+    }
+  }
 }
 
 // Every example project (seed 1, 120 s). The cube's insertions slide each cube down along its

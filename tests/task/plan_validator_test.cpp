@@ -198,7 +198,8 @@ TEST_F(PlanValidatorTest, PickAndPlaceValidates) {
   EXPECT_TRUE(v.valid) << Issues(v);
   EXPECT_EQ(v.actions, 2);
   EXPECT_EQ(v.keyframes, 3);
-  EXPECT_EQ(v.wrench_checks, 2);  // transport after the pick, rest after the place
+  // Transport after the pick; at the place, rest and the leg carried down to it alone.
+  EXPECT_EQ(v.wrench_checks, 3);
   EXPECT_GE(v.collision_checks, 3);
   // The whole stool is not built: incomplete when the plan must be complete.
   const PlanValidation full = Validate(PlanValidationOptions{});
@@ -264,7 +265,9 @@ TEST_F(PlanValidatorTest, TinyGripperLimitsGiveWrenchIssue) {
   project_.robots[kRobotA].wrench_limits = tiny;
   const PlanValidation v = Validate();
   EXPECT_TRUE(v.HasIssue("wrench_transport", 0)) << Issues(v);
-  EXPECT_FALSE(v.HasIssue("wrench_rest")) << Issues(v);  // the table alone holds it after
+  // Carried down to the table by the same gripper, then the table alone holds it.
+  EXPECT_TRUE(v.HasIssue("wrench_transport", 1)) << Issues(v);
+  EXPECT_FALSE(v.HasIssue("wrench_rest")) << Issues(v);
   // Without wrench checks the same plan passes.
   PlanValidationOptions no_wrench = Partial();
   no_wrench.wrench_mode = MatingWrenchMode::kNone;
