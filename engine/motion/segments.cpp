@@ -87,9 +87,9 @@ class Builder {
       const std::vector<int>& robots, const std::vector<JointVector>& q0,
       const std::vector<std::function<Iso3(double)>>& targets, int steps,
       const std::vector<JointVector>* goals = nullptr);
-  // The fewest of `path`'s samples (the first and the last kept) between which straight joint
-  // motion stays within a fraction of a millimetre of every dropped sample's TCP pose: a skill
-  // is timed piece by piece, each piece from rest to rest, so a line tracked at millimetres
+  // One arm's path: the fewest of its samples (the first and the last kept) between which straight
+  // joint motion stays within a fraction of a millimetre of every dropped sample's TCP pose: a
+  // skill is timed piece by piece, each piece from rest to rest, so a line tracked at millimetres
   // would be driven in jerks (MuJoCo saw the load on a lifting gripper swing by +-30%).
   std::vector<std::vector<JointVector>> Simplify(const std::vector<int>& robots,
                                                  std::vector<std::vector<JointVector>> path) const;
@@ -421,11 +421,13 @@ std::vector<std::vector<JointVector>> Builder::Track(
 
 std::vector<std::vector<JointVector>> Builder::Simplify(
     const std::vector<int>& robots, std::vector<std::vector<JointVector>> path) const {
-  if (path.size() <= 2) return path;
-  // One arm may leave its Cartesian line by half a millimetre; arms that hold one object
-  // together by less, as they pull on it against each other.
-  const double tol_m = robots.size() > 1 ? 2e-4 : 5e-4;
-  const double tol_rad = robots.size() > 1 ? 2e-3 : 5e-3;
+  // Arms that hold one object together keep every sample: where two grippers leave their
+  // lines differently they pull on the object against each other (MuJoCo saw 50 N inside a
+  // cross's base carried with 0.2 mm of tolerance, more than stop and go costs).
+  if (path.size() <= 2 || robots.size() > 1) return path;
+  // One arm may leave its Cartesian line by half a millimetre.
+  const double tol_m = 5e-4;
+  const double tol_rad = 5e-3;
   std::vector<std::vector<Iso3>> X(path.size(), std::vector<Iso3>(robots.size()));
   for (size_t k = 0; k < path.size(); ++k) {
     for (size_t i = 0; i < robots.size(); ++i) X[k][i] = Tcp(robots[i], path[k][i]);
