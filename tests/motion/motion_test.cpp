@@ -165,6 +165,61 @@ struct Planned : PreparedProject {
 
 const Planned& PlanOnce(const std::string& name) { return PrepareOnce<Planned>(name); }
 
+// An object that robot r carries alone during segment m (computed here, apart from the
+// planner): its mass, its centre of mass in the grasp frame and the gripper's box (a vacuum
+// cup's transport limits, the two-finger limits).
+struct SoleCarry {
+  int robot = -1;
+  double mass = 0.0;
+  Vec3 com_G = Vec3::Zero();
+  const TaskRobot* model = nullptr;
+  const WrenchBox* box = nullptr;
+  // The largest ratio of a component of what the gripper applies on the object (its weight, and
+  // its inertia when asked: the acceleration by central differences) to its limit, at time t.
+  double Ratio(const Plan& plan, double t, bool inertia) const {
+    auto X_WG = [&](double s) {
+      return TcpPose(model->chain, model->X_WB, SampleTrajectory(plan.trajectories[robot], s),
+                     model->end_effector.X_FT);
+    };
+    const double h = 0.001;
+    const Iso3 X = X_WG(t);
+    Vec3 a = Vec3::Zero();
+    if (inertia) a = (X_WG(t + h) * com_G - 2.0 * (X * com_G) + X_WG(t - h) * com_G) / (h * h);
+    const Vec3 f = X.linear().transpose() * (mass * (a + Vec3(0, 0, 9.81)));
+    const Vec3 tau = com_G.cross(f);
+    double u = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      u = std::max({u, std::abs(f[i]) / box->force_N[i], std::abs(tau[i]) / box->torque_Nm[i]});
+    }
+    return u;
+  }
+};
+
+std::optional<SoleCarry> CarriedAlone(const TaskWorld& w, const Plan& plan,
+                                      const std::vector<PlanState>& states, const MotionSegment& m,
+                                      int r) {
+  if (m.action < 0 || m.action + 1 >= static_cast<int>(states.size())) return std::nullopt;
+  // Before its action, or after it (the robots' way home at the end).
+  const bool after = m.start_s >= plan.actions[m.action].end_s - 1e-9;
+  const PlanState& st = states[m.action + (after ? 1 : 0)];
+  const int node = st.held[r];
+  if (node < 0 || st.Holders(node).size() != 1) return std::nullopt;
+  SoleCarry c;
+  c.robot = r;
+  Vec3 com_A = Vec3::Zero();
+  for (int part : w.tree->nodes[node].parts) {
+    c.mass += w.part_mass[part];
+    com_A += w.part_mass[part] * w.part_com_A[part];
+  }
+  com_A /= c.mass;
+  const PlanGrasp& g = st.grasp[r];
+  c.com_G = (w.X_AP[g.part] * g.X_PG).inverse() * com_A;
+  c.model = &w.robots[r];
+  c.box = c.model->end_effector.kind == EndEffectorKind::kVacuum ? &c.model->limits.vacuum_transport
+                                                                 : &c.model->limits.two_finger;
+  return c;
+}
+
 class ExampleMotion : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ExampleMotion, TrajectoriesPassTheIndependentChecks) {
@@ -223,44 +278,17 @@ TEST_P(ExampleMotion, TrajectoriesPassTheIndependentChecks) {
   const std::vector<PlanState> states = ReplayPlanStates(plan);
   int loaded = 0;
   for (const MotionSegment& m : plan.segments) {
-    if (m.kind != "free" || m.action < 0 || m.action + 1 >= static_cast<int>(states.size())) {
-      continue;
-    }
-    // Before its action, or after it (the robots' way home at the end).
-    const bool after = m.start_s >= plan.actions[m.action].end_s - 1e-9;
-    const PlanState& st = states[m.action + (after ? 1 : 0)];
+    if (m.kind != "free") continue;
     for (int r : m.robots) {
-      const int node = st.held[r];
-      if (node < 0 || st.Holders(node).size() != 1) continue;
-      double mass = 0.0;
-      Vec3 com_A = Vec3::Zero();
-      for (int part : w.tree->nodes[node].parts) {
-        mass += w.part_mass[part];
-        com_A += w.part_mass[part] * w.part_com_A[part];
-      }
-      com_A /= mass;
-      const PlanGrasp& g = st.grasp[r];
-      const Iso3 X_AG = w.X_AP[g.part] * g.X_PG;
-      const TaskRobot& robot = w.robots[r];
-      const WrenchBox& box = robot.end_effector.kind == EndEffectorKind::kVacuum
-                                 ? robot.limits.vacuum_transport
-                                 : robot.limits.two_finger;
-      auto ratio = [&](double t) {
-        const JointVector q = SampleTrajectory(plan.trajectories[r], t);
-        const Iso3 X_WG = TcpPose(robot.chain, robot.X_WB, q, robot.end_effector.X_FT);
-        const Vec3 f = X_WG.linear().transpose() * Vec3(0, 0, -9.81 * mass);
-        const Vec3 tau = (X_AG.inverse() * com_A).cross(f);
-        double u = 0.0;
-        for (int i = 0; i < 3; ++i) {
-          u = std::max({u, std::abs(f[i]) / box.force_N[i], std::abs(tau[i]) / box.torque_Nm[i]});
-        }
-        return u;
-      };
-      const double bound = std::max({0.8, ratio(m.start_s), ratio(m.end_s)}) + 1e-6;
+      const std::optional<SoleCarry> c = CarriedAlone(w, plan, states, m, r);
+      if (!c) continue;
+      const double bound =
+          std::max({0.8, c->Ratio(plan, m.start_s, false), c->Ratio(plan, m.end_s, false)}) + 1e-6;
       for (int k = 0; k <= 40; ++k) {
         const double t = m.start_s + (m.end_s - m.start_s) * k / 40.0;
-        EXPECT_LE(ratio(t), bound) << "robot " << plan.robots[r] << " at t = " << t
-                                   << " in the free segment of action " << m.action + 1;
+        EXPECT_LE(c->Ratio(plan, t, false), bound)
+            << "robot " << plan.robots[r] << " at t = " << t << " in the free segment of action "
+            << m.action + 1;
       }
       ++loaded;
     }
@@ -274,50 +302,15 @@ TEST_P(ExampleMotion, TrajectoriesPassTheIndependentChecks) {
   // 90% of the limits in any moving segment, or a little more than its weight alone does there
   // (MuJoCo's welds feel both; sampled at other moments than the planner's, hence 0.03).
   for (const MotionSegment& m : plan.segments) {
-    if (m.kind == "grip" || m.action < 0 || m.action + 1 >= static_cast<int>(states.size()) ||
-        !(m.end_s > m.start_s + 0.01)) {
-      continue;
-    }
-    const bool after = m.start_s >= plan.actions[m.action].end_s - 1e-9;
-    const PlanState& st = states[m.action + (after ? 1 : 0)];
+    if (m.kind == "grip" || !(m.end_s > m.start_s + 0.01)) continue;
     for (int r : m.robots) {
-      const int node = st.held[r];
-      if (node < 0 || st.Holders(node).size() != 1) continue;
-      double mass = 0.0;
-      Vec3 com_A = Vec3::Zero();
-      for (int part : w.tree->nodes[node].parts) {
-        mass += w.part_mass[part];
-        com_A += w.part_mass[part] * w.part_com_A[part];
-      }
-      com_A /= mass;
-      const PlanGrasp& g = st.grasp[r];
-      const Vec3 com_G = (w.X_AP[g.part] * g.X_PG).inverse() * com_A;
-      const TaskRobot& robot = w.robots[r];
-      const WrenchBox& box = robot.end_effector.kind == EndEffectorKind::kVacuum
-                                 ? robot.limits.vacuum_transport
-                                 : robot.limits.two_finger;
-      auto X_WG = [&](double t) {
-        return TcpPose(robot.chain, robot.X_WB, SampleTrajectory(plan.trajectories[r], t),
-                       robot.end_effector.X_FT);
-      };
-      auto ratio = [&](double t, bool inertia) {
-        const double h = 0.001;
-        const Iso3 X = X_WG(t);
-        Vec3 a = Vec3::Zero();
-        if (inertia) a = (X_WG(t + h) * com_G - 2.0 * (X * com_G) + X_WG(t - h) * com_G) / (h * h);
-        const Vec3 f = X.linear().transpose() * (mass * (a + Vec3(0, 0, 9.81)));
-        const Vec3 tau = com_G.cross(f);
-        double u = 0.0;
-        for (int i = 0; i < 3; ++i) {
-          u = std::max({u, std::abs(f[i]) / box.force_N[i], std::abs(tau[i]) / box.torque_Nm[i]});
-        }
-        return u;
-      };
+      const std::optional<SoleCarry> c = CarriedAlone(w, plan, states, m, r);
+      if (!c) continue;
       double weight = 0.0, total = 0.0, t_peak = m.start_s;
       for (int k = 0; k <= 60; ++k) {
         const double t = m.start_s + 0.002 + (m.end_s - m.start_s - 0.004) * k / 60.0;
-        weight = std::max(weight, ratio(t, false));
-        if (const double u = ratio(t, true); u > total) {
+        weight = std::max(weight, c->Ratio(plan, t, false));
+        if (const double u = c->Ratio(plan, t, true); u > total) {
           total = u;
           t_peak = t;
         }
