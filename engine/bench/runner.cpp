@@ -97,6 +97,11 @@ pid_t Spawn(const std::vector<std::string>& argv, const fs::path& log, long long
     dup2(null_fd, 0);
     close(null_fd);
   }
+#if defined(__SANITIZE_ADDRESS__)
+  // An AddressSanitizer build maps terabytes of shadow memory at start: under an address-space
+  // limit its children could not start. Such a build runs without the limit.
+  as_mib = 0;
+#endif
   if (as_mib > 0) {
     rlimit lim{};
     lim.rlim_cur = lim.rlim_max = static_cast<rlim_t>(as_mib) * 1024 * 1024;

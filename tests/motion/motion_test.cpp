@@ -144,11 +144,12 @@ TEST(OmplAdapter, NoPathTimesOutAndStopsOnRequest) {
 Plan RunPipeline(const PreparedProject& p, std::uint64_t seed, std::string* error,
                  double segment_time_s = 0.0) {
   RunContext ctx(seed);
-  ctx.set_time_limit_s(120.0);
+  ctx.set_time_limit_s(120.0 * kTimeScale);
   PipelineOptions options;
   options.task.project_file = p.file;
   options.seed = seed;
   if (segment_time_s > 0.0) options.motion.segment_time_s = segment_time_s;
+  options.motion.segment_time_s *= kTimeScale;
   auto plan = PlanAssembly(*p.lp.project, p.lp.check, *p.pre, options, ctx);
   if (!plan) {
     *error = plan.error().message;
@@ -394,7 +395,9 @@ TEST(Motion, FreePathsMarkedForAnotherSeedAreSearchedAgain) {
   Plan first = strip(*p.plan);
   MotionCache cache;
   RunContext ctx(1);
-  auto a = PlanMotion(*p.world, first, MotionOptions{}, 1, 5, cache, ctx);
+  MotionOptions options;
+  options.segment_time_s *= kTimeScale;
+  auto a = PlanMotion(*p.world, first, options, 1, 5, cache, ctx);
   ASSERT_TRUE(a && a->solved);
   // The searched (not straight) free paths, marked; their cached paths forgotten.
   std::vector<std::vector<std::vector<JointVector>>> before(cache.free_paths.size());
@@ -409,7 +412,7 @@ TEST(Motion, FreePathsMarkedForAnotherSeedAreSearchedAgain) {
   }
   ASSERT_GT(marked, 0);
   Plan again = strip(*p.plan);
-  auto b = PlanMotion(*p.world, again, MotionOptions{}, 1, 5, cache, ctx);
+  auto b = PlanMotion(*p.world, again, options, 1, 5, cache, ctx);
   ASSERT_TRUE(b && b->solved) << (b ? b->failure.message : b.error().message);
   int differ = 0;
   for (size_t k = 0; k < before.size() && k < cache.free_paths.size(); ++k) {

@@ -13,6 +13,19 @@ namespace {
 std::atomic<long> g_allocations{0};
 }  // namespace
 
+#if defined(__SANITIZE_ADDRESS__)
+// Under AddressSanitizer the allocation functions are its own: FCL's library allocates with
+// them and FCL's inline destructors, compiled here, would free with ours (an
+// alloc-dealloc-mismatch). Its allocator's hooks count every allocation instead.
+#include <sanitizer/allocator_interface.h>
+namespace {
+void CountAllocation(const volatile void*, std::size_t) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+}
+void IgnoreFree(const volatile void*) {}
+const int g_hooks = __sanitizer_install_malloc_and_free_hooks(CountAllocation, IgnoreFree);
+}  // namespace
+#else
 // g++ 12 sees the malloc behind these replacements and warns that free() meets operator new.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 
@@ -31,6 +44,7 @@ void operator delete(void* p) noexcept { std::free(p); }
 void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#endif
 
 namespace wrap {
 namespace {
