@@ -17,7 +17,10 @@ std::atomic<long> g_allocations{0};
 // Under AddressSanitizer the allocation functions are its own: FCL's library allocates with
 // them and FCL's inline destructors, compiled here, would free with ours (an
 // alloc-dealloc-mismatch). Its allocator's hooks count every allocation instead.
-#include <sanitizer/allocator_interface.h>
+// (The sanitizer runtime's interface; GCC ships no header declaring it.)
+extern "C" int __sanitizer_install_malloc_and_free_hooks(void (*malloc_hook)(const volatile void*,
+                                                                             std::size_t),
+                                                         void (*free_hook)(const volatile void*));
 namespace {
 void CountAllocation(const volatile void*, std::size_t) {
   g_allocations.fetch_add(1, std::memory_order_relaxed);
