@@ -106,8 +106,9 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
                      PlannerRequest request) {
   // The GUI thread draws while this one plans: on a machine with few cores, planning at a lower
   // priority keeps the window responsive (Linux: nice is per thread; threads this one starts,
-  // e.g. the parallel grasp sampling, inherit it).
-  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 5);
+  // e.g. the parallel grasp sampling, inherit it). Nice 15: at 5 the chair's window drew 18 fps
+  // on two cores under llvmpipe, at 15 34 fps, with planning 6-16% slower (BENCHMARKS.md).
+  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 15);
   try {
     RunContext ctx(request.seed);
     ctx.set_stop_token(stop);
