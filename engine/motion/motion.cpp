@@ -34,56 +34,40 @@ class CarryLoad {
     const bool after = t0 >= action_end_s[g.action] - 1e-9;
     const PlanState& st = states[static_cast<size_t>(g.action) + (after ? 1 : 0)];
     for (int r : g.robots) {
-      const int node = st.held[r];
-      if (node < 0 || st.Holders(node).size() != 1) continue;
-      double mass = 0.0;
-      Vec3 com_A = Vec3::Zero();
-      for (int p : world.tree->nodes[node].parts) {
-        mass += world.part_mass[p];
-        com_A += world.part_mass[p] * world.part_com_A[p];
-      }
-      if (!(mass > 0.0)) continue;
-      com_A /= mass;
-      const PlanGrasp& grasp = st.grasp[r];
-      const Vec3 com_G = (world.X_AP[grasp.part] * grasp.X_PG).inverse() * com_A;
+      const std::optional<SoleLoad> load = SoleLoadOf(world, st, r);
+      if (!load) continue;
       const TaskRobot& robot = world.robots[r];
-      const WrenchBox& box = robot.end_effector.kind == EndEffectorKind::kVacuum
-                                 ? robot.limits.vacuum_transport
-                                 : robot.limits.two_finger;
       auto X_WG = [&](double t) {
         return TcpPose(robot.chain, robot.X_WB, SampleTrajectory(plan.trajectories[r], t),
                        robot.end_effector.X_FT);
       };
+      const Vec3& c = load->com_G;
       constexpr double h = 0.002;  // [s]
       const int n = std::max(8, static_cast<int>(std::ceil((t1 - t0) / 0.02)));
+      loads_.push_back(*load);
       for (int k = 0; k <= n; ++k) {
         const double t = std::clamp(t0 + (t1 - t0) * k / n, t0 + h, t1 - h);
         const Iso3 X = X_WG(t);
-        const Vec3 a = (X_WG(t + h) * com_G - 2.0 * (X * com_G) + X_WG(t - h) * com_G) / (h * h);
-        // What the gripper applies on the object, in the grasp frame.
-        samples_.push_back({X.linear().transpose() * (mass * Vec3(0.0, 0.0, 9.81)),
-                            X.linear().transpose() * (mass * a), com_G, &box});
+        const Vec3 a = (X_WG(t + h) * c - 2.0 * (X * c) + X_WG(t - h) * c) / (h * h);
+        samples_.push_back({loads_.size() - 1, X.linear(), a});
       }
     }
   }
   double Peak(double accel_scale) const {
     double peak = 0.0;
     for (const Sample& s : samples_) {
-      const Vec3 f = s.weight + accel_scale * s.inertia;
-      const Vec3 tau = s.com_G.cross(f);
-      for (int i = 0; i < 3; ++i) {
-        peak = std::max({peak, std::abs(f[i]) / std::max(s.box->force_N[i], 1e-9),
-                         std::abs(tau[i]) / std::max(s.box->torque_Nm[i], 1e-9)});
-      }
+      peak = std::max(peak, LoadRatio(loads_[s.load], s.R_WG, accel_scale * s.accel_W));
     }
     return peak;
   }
 
  private:
   struct Sample {
-    Vec3 weight, inertia, com_G;
-    const WrenchBox* box;
+    size_t load;  // index in loads_
+    Mat3 R_WG;
+    Vec3 accel_W;  // the centre of mass's acceleration
   };
+  std::vector<SoleLoad> loads_;
   std::vector<Sample> samples_;
 };
 

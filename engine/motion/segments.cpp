@@ -133,17 +133,12 @@ class Builder {
   std::vector<double> SceneKey() const;
   bool Retreat(int action, int robot);
   // The weight of an object that robot `robot` holds alone, as its gripper takes it.
-  struct Load {
-    int robot = -1;
-    double mass = 0.0;
-    Vec3 com_A = Vec3::Zero();     // centre of mass in the assembly frame
-    Iso3 X_GA = Iso3::Identity();  // assembly frame in the grasp (TCP) frame
-    WrenchBox box;                 // the gripper's limits while carrying
-  };
   // The loads of the robots of `robots` that carry an object alone (state_).
-  std::vector<Load> SoleLoads(const std::vector<int>& robots) const;
-  // Largest ratio of a component of the load's wrench (grasp frame) to its limit at joints q.
-  double LoadRatio(const Load& load, const JointVector& q) const;
+  std::vector<SoleLoad> SoleLoads(const std::vector<int>& robots) const;
+  // LoadRatio of the load's weight at joints q.
+  double LoadRatio(const SoleLoad& load, const JointVector& q) const {
+    return wrap::LoadRatio(load, Tcp(load.robot, q).linear());
+  }
   // Sets robot's finger opening for a free move toward a grasp: `wanted`, unless the fingers at
   // `wanted` hit something where the robot stands and at their present opening do not (then
   // they stay). False when the scene cannot be set.
@@ -564,43 +559,12 @@ std::vector<JointVector> Builder::BackOff(int robot, const JointVector& q, doubl
   return {};
 }
 
-std::vector<Builder::Load> Builder::SoleLoads(const std::vector<int>& robots) const {
-  std::vector<Load> out;
+std::vector<SoleLoad> Builder::SoleLoads(const std::vector<int>& robots) const {
+  std::vector<SoleLoad> out;
   for (int r : robots) {
-    const int node = state_.held[r];
-    if (node < 0 || state_.Holders(node).size() != 1) continue;
-    Load l;
-    l.robot = r;
-    for (int p : w_.tree->nodes[node].parts) {
-      l.mass += w_.part_mass[p];
-      l.com_A += w_.part_mass[p] * w_.part_com_A[p];
-    }
-    if (!(l.mass > 0.0)) continue;
-    l.com_A /= l.mass;
-    const PlanGrasp& g = state_.grasp[r];
-    l.X_GA = (w_.X_AP[g.part] * g.X_PG).inverse();
-    const TaskRobot& tr = w_.robots[r];
-    l.box = tr.end_effector.kind == EndEffectorKind::kVacuum ? tr.limits.vacuum_transport
-                                                             : tr.limits.two_finger;
-    out.push_back(l);
+    if (std::optional<SoleLoad> l = SoleLoadOf(w_, state_, r)) out.push_back(*l);
   }
   return out;
-}
-
-double Builder::LoadRatio(const Load& load, const JointVector& q) const {
-  constexpr double kG = 9.81;
-  const Iso3 X_WG = Tcp(load.robot, q);
-  const Mat3 R_GW = X_WG.linear().transpose();
-  // Gravity on the object, and its moment about the grasp point, in the grasp frame.
-  const Vec3 f_G = R_GW * Vec3(0.0, 0.0, -load.mass * kG);
-  const Vec3 c_G = load.X_GA * load.com_A;
-  const Vec3 tau_G = c_G.cross(f_G);
-  double u = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    u = std::max(u, std::abs(f_G[i]) / std::max(load.box.force_N[i], 1e-9));
-    u = std::max(u, std::abs(tau_G[i]) / std::max(load.box.torque_Nm[i], 1e-9));
-  }
-  return u;
 }
 
 bool Builder::MoveOpening(int robot, double wanted) {
@@ -731,9 +695,9 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
     };
     // Objects carried by one robot: their weight on the gripper stays within the limits' share
     // (or the worse of the two ends' loads).
-    const std::vector<Load> loads = SoleLoads(who);
+    const std::vector<SoleLoad> loads = SoleLoads(who);
     std::vector<std::pair<size_t, double>> load_bound;  // (index in who, largest ratio)
-    for (const Load& load : loads) {
+    for (const SoleLoad& load : loads) {
       const size_t i =
           static_cast<size_t>(std::find(who.begin(), who.end(), load.robot) - who.begin());
       load_bound.push_back({i, std::max({opt_.transport_load_max, LoadRatio(load, cur_[who[i]]),
@@ -1834,6 +1798,40 @@ Result<std::vector<GeoSegment>> PlanGeometricMotion(const TaskWorld& world, Plan
                                                     RunContext& ctx, MotionFailure* failure) {
   Builder builder(world, plan, options, effort, seed, cache, ctx, failure);
   return builder.Run();
+}
+
+std::optional<SoleLoad> SoleLoadOf(const TaskWorld& world, const PlanState& state, int robot) {
+  const int node = state.held[robot];
+  if (node < 0 || state.Holders(node).size() != 1) return std::nullopt;
+  SoleLoad l;
+  l.robot = robot;
+  Vec3 com_A = Vec3::Zero();
+  for (int p : world.tree->nodes[node].parts) {
+    l.mass += world.part_mass[p];
+    com_A += world.part_mass[p] * world.part_com_A[p];
+  }
+  if (!(l.mass > 0.0)) return std::nullopt;
+  com_A /= l.mass;
+  const PlanGrasp& g = state.grasp[robot];
+  l.com_G = (world.X_AP[g.part] * g.X_PG).inverse() * com_A;
+  const TaskRobot& tr = world.robots[robot];
+  l.box = tr.end_effector.kind == EndEffectorKind::kVacuum ? tr.limits.vacuum_transport
+                                                           : tr.limits.two_finger;
+  return l;
+}
+
+double LoadRatio(const SoleLoad& load, const Mat3& R_WG, const Vec3& accel_W) {
+  constexpr double kG = 9.81;
+  // What the gripper applies on the object, and its moment about the grasp point, in the grasp
+  // frame.
+  const Vec3 f_G = R_WG.transpose() * (load.mass * (accel_W + Vec3(0.0, 0.0, kG)));
+  const Vec3 tau_G = load.com_G.cross(f_G);
+  double u = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    u = std::max(u, std::abs(f_G[i]) / std::max(load.box.force_N[i], 1e-9));
+    u = std::max(u, std::abs(tau_G[i]) / std::max(load.box.torque_Nm[i], 1e-9));
+  }
+  return u;
 }
 
 }  // namespace wrap

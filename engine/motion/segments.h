@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -103,6 +104,22 @@ struct MotionCache {
   /// timed result grazed something between the path's checked states (see PlanMotion).
   std::map<int, int> reseed;
 };
+
+/// An object that one robot carries alone: its mass, its centre of mass in the grasp (TCP)
+/// frame, and the gripper's limits while carrying (a vacuum cup's transport box, the two-finger
+/// box).
+struct SoleLoad {
+  int robot = -1;
+  double mass = 0.0;
+  Vec3 com_G = Vec3::Zero();
+  WrenchBox box;
+};
+/// What robot `robot` carries alone in `state`, if anything (nothing, or no mass: nullopt).
+std::optional<SoleLoad> SoleLoadOf(const TaskWorld& world, const PlanState& state, int robot);
+/// Largest ratio of a component of the wrench the gripper applies on `load` (weight, plus the
+/// inertia of a centre of mass accelerating by `accel_W`), in the grasp frame whose world
+/// orientation is R_WG, to its limit.
+double LoadRatio(const SoleLoad& load, const Mat3& R_WG, const Vec3& accel_W = Vec3::Zero());
 
 /// The geometric motion of `plan` at effort level `effort`. Keyframes stay, except where a straight
 /// two-handed carry or an insertion reaches the keyframe's TCP pose on another IK solution that is
