@@ -391,8 +391,13 @@ class Simulator {
     Weld(grip_eq_[r][g.part], TcpBodyPose(r), PartPose(g.part));
   }
 
+  // Its weld off now (and back to its own stiffness, if it was softening).
   void Release(int r) {
-    if (grip_part_[r] >= 0) model_->eq_active[grip_eq_[r][grip_part_[r]]] = 0;
+    if (grip_part_[r] >= 0) {
+      const int eq = grip_eq_[r][grip_part_[r]];
+      StopSoftening(eq);
+      model_->eq_active[eq] = 0;
+    }
     grip_part_[r] = -1;
   }
 
@@ -607,14 +612,8 @@ class Simulator {
       Object& o = objects_[node];
       if (o.holders.size() == 1 && o.holders.front() == r) o.X_WA = ExpectedX_WA(o);
       o.holders.erase(std::remove(o.holders.begin(), o.holders.end(), r), o.holders.end());
-      // Its weld has softened away since kReleaseRamp_s before (SoftenBeforeReleases) and
-      // goes off now, if not already.
-      if (grip_part_[r] >= 0) {
-        const int eq = grip_eq_[r][grip_part_[r]];
-        StopSoftening(eq);
-        model_->eq_active[eq] = 0;
-      }
-      grip_part_[r] = -1;
+      // Its weld has softened away since kReleaseRamp_s before (SoftenBeforeReleases).
+      Release(r);
     };
     switch (a.type) {
       case ActionType::kPick:
