@@ -112,7 +112,7 @@ class Writer {
       // Multi-point convex collision: with one contact per mesh-box pair a flat part rocks
       // and tips over the table's edge instead of resting on its face.
       Line("<option timestep=\"" + Num(options_.timestep_s) +
-           "\" gravity=\"0 0 -9.81\" jacobian=\"dense\">");
+           "\" gravity=\"0 0 -9.81\" jacobian=\"dense\" cone=\"elliptic\" impratio=\"10\">");
       Line("  <flag multiccd=\"enable\"/>");
       Line("</option>");
       Line("<size njmax=\"6000\" nconmax=\"1500\"/>");

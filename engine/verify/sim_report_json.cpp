@@ -56,6 +56,7 @@ std::string SerializeSimReport(const SimReport& report) {
   j["motion"] = report.motion;
   j["collisions_judged"] = report.collisions_judged;
   j["collision_checks"] = report.collision_checks;
+  j["split_measurements"] = report.split_measurements;
   j["notes"] = report.notes;
   j["warnings"] = report.warnings;
   return j.dump(2) + "\n";

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <limits>
 #include <map>
 #include <memory>
@@ -17,6 +18,8 @@
 #include "sim/scene.h"
 #include "verify/detail/collisions.h"
 #include "verify/detail/keyframe_replay.h"
+#include "wrench/lp.h"
+#include "wrench/wrench.h"
 
 namespace wrap {
 
@@ -24,12 +27,48 @@ namespace {
 
 constexpr int kWeldRows = 6;             // a weld constrains 3 positions and 3 rotations
 constexpr double kReleaseGrace_s = 0.5;  // a released object may touch its gripper this long
-// A gripper lets go over this long before its release's moment (its fingers open, its cup
-// vents, while the plan holds it still): its weld softens to nothing, so the object's other
-// holders or the table take the load over gradually. Cut at once, a weld hands a step load to
-// the others, and MuJoCo's constraints (critically damped) overshoot a step by 13%: a
-// co-holder at 86% of its limits read 112% for a moment.
+// A gripper lets go over this long before its release's moment (Simulator::Fade).
 constexpr double kReleaseRamp_s = 0.1;
+// BestSplit: an object's vertices this close to the table top may bear on it [m]; at most this
+// many corners of their hull are used.
+constexpr double kSupportReach_m = 0.001;
+constexpr size_t kMaxSupportPoints = 16;
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+Mat3 Skew(const Vec3& v) {
+  Mat3 S;
+  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return S;
+}
+
+// The corners of the convex hull of `points` (Andrew's monotone chain), counter-clockwise, at
+// most `max_corners` of them (evenly picked when there are more).
+std::vector<Eigen::Vector2d> ConvexHull2d(std::vector<Eigen::Vector2d> points, size_t max_corners) {
+  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  points.erase(std::unique(points.begin(), points.end()), points.end());
+  if (points.size() < 3) return points;
+  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  std::vector<Eigen::Vector2d> hull(2 * points.size());
+  size_t k = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  for (size_t i = points.size() - 1, lower = k + 1; i > 0; --i) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], points[i - 1]) <= 0) --k;
+    hull[k++] = points[i - 1];
+  }
+  hull.resize(k - 1);
+  if (hull.size() <= max_corners) return hull;
+  std::vector<Eigen::Vector2d> picked;
+  for (size_t i = 0; i < max_corners; ++i) picked.push_back(hull[i * hull.size() / max_corners]);
+  return picked;
+}
 
 double AngleOf(const Mat3& R) { return std::abs(Eigen::AngleAxisd(R).angle()); }
 
@@ -143,6 +182,23 @@ class Simulator {
   }
 
  private:
+  // A gripper being let go of, from kReleaseRamp_s before its release's moment (its fingers
+  // open, its cup vents, while the plan holds it still): from t0 its weld is off and the wrench
+  // the weld last exerted on the part is applied instead, falling linearly to nothing over
+  // kReleaseRamp_s, so that the object's other holders or the table take the load over
+  // gradually. (Softening the weld instead does not hand the load over: at rest a MuJoCo
+  // constraint resists through its impedance whatever its stiffness, and the load stepped over
+  // at the cut; MuJoCo's critically damped constraints overshoot a step: a co-holder at 82% of
+  // its limits read 102% for 20 ms.)
+  struct Fade {
+    int robot = -1;
+    int part = -1;
+    double t0 = 0.0;      // starts [s]
+    bool started = false;
+    Vec3 f_W = Vec3::Zero();    // the weld's last force on the part, world
+    Vec3 tau_W = Vec3::Zero();  // and torque, about the part's origin
+  };
+
   struct Object {
     Iso3 X_WA = Iso3::Identity();  // where it should be while nobody holds it
     std::vector<int> holders;      // robots, ascending
@@ -212,6 +268,8 @@ class Simulator {
       limits_.push_back(r.wrench_limits.value_or(project_.wrench_limits));
     }
     grip_part_.assign(nr, -1);
+    mating_on_part_.assign(np, Vec6::Zero());
+    recent_.assign(nr, {});
     grasp_.assign(nr, PlanGrasp{});
     hold_f_.assign(nr, Vec3::Zero());
     hold_tau_.assign(nr, Vec3::Zero());
@@ -323,26 +381,29 @@ class Simulator {
     e[7] = q.x();
     e[8] = q.y();
     e[9] = q.z();
-    StopSoftening(eq);
     model_->eq_active[eq] = 1;
   }
 
-  // Weld `eq` is let go of from time t over kReleaseRamp_s (see SoftenReleases).
-  void SoftReleaseWeld(int eq, double t) {
-    StopSoftening(eq);
-    releasing_.push_back({eq, t, model_->eq_solref[mjNREF * eq]});
-  }
-  void StopSoftening(int eq) {
-    for (size_t i = 0; i < releasing_.size(); ++i) {
-      if (releasing_[i].eq != eq) continue;
-      model_->eq_solref[mjNREF * eq] = releasing_[i].time_const;
-      releasing_.erase(releasing_.begin() + static_cast<std::ptrdiff_t>(i));
-      return;
+  // Robot r's fade (see Fade), or null.
+  const Fade* FadeOf(int r) const {
+    for (const Fade& f : fades_) {
+      if (f.robot == r) return &f;
     }
+    return nullptr;
   }
+  void StopFade(int r) {
+    fades_.erase(std::remove_if(fades_.begin(), fades_.end(),
+                                [&](const Fade& f) { return f.robot == r; }),
+                 fades_.end());
+  }
+  // What is left of a started fade at time t: 1 at its start, 0 from kReleaseRamp_s on.
+  static double FadeLeft(const Fade& f, double t) {
+    return std::clamp(1.0 - (t - f.t0) / kReleaseRamp_s, 0.0, 1.0);
+  }
+
   // Releases (a place, a release, a handover's giver) due within kReleaseRamp_s of t whose
-  // robot holds: its weld starts to soften.
-  void SoftenBeforeReleases(double t) {
+  // robot holds: its fade is scheduled.
+  void FadeBeforeReleases(double t) {
     for (size_t e = next_event_; e < order_.size(); ++e) {
       const PlanAction& a = plan_.actions[order_[e]];
       if (a.end_s > t + kReleaseRamp_s) break;
@@ -360,26 +421,38 @@ class Simulator {
           Grip(r2, a.grasps[1].grasp);
         }
       }
-      const int eq = grip_eq_[r][grip_part_[r]];
-      const bool started = std::any_of(releasing_.begin(), releasing_.end(),
-                                       [&](const Releasing& w) { return w.eq == eq; });
-      if (!started) SoftReleaseWeld(eq, a.end_s - kReleaseRamp_s);
+      if (!FadeOf(r)) {
+        Fade f;
+        f.robot = r;
+        f.part = grip_part_[r];
+        f.t0 = a.end_s - kReleaseRamp_s;
+        fades_.push_back(f);
+      }
     }
   }
-  // The welds being let go of at time t: stiffness (1 / time constant^2) falls as (1 - s)^2
-  // over the ramp (s from 0 to 1), then the weld is off.
-  void SoftenReleases(double t) {
-    for (size_t i = 0; i < releasing_.size();) {
-      const Releasing& w = releasing_[i];
-      const double s = (t - w.t0) / kReleaseRamp_s;
-      if (s >= 0.99) {
-        model_->eq_active[w.eq] = 0;
-        model_->eq_solref[mjNREF * w.eq] = w.time_const;
-        releasing_.erase(releasing_.begin() + static_cast<std::ptrdiff_t>(i));
-        continue;
+  // The fades at time t (after xfrc_applied was cleared): one due starts (its weld's last
+  // wrench taken over, the weld off), every started one applies what is left of its wrench.
+  void ApplyFades(double t) {
+    for (Fade& f : fades_) {
+      if (!f.started) {
+        if (t < f.t0) continue;
+        const int eq = grip_eq_[f.robot][f.part];
+        WeldWrench(eq, f.part, f.f_W, f.tau_W);
+        model_->eq_active[eq] = 0;
+        f.started = true;
       }
-      model_->eq_solref[mjNREF * w.eq] = w.time_const / (1.0 - std::max(0.0, s));
-      ++i;
+      const double k = FadeLeft(f, t);
+      if (k <= 0.0) continue;
+      const int body = part_body_[f.part];
+      const Vec3 com(data_->xipos[3 * body], data_->xipos[3 * body + 1],
+                     data_->xipos[3 * body + 2]);
+      // tau_W is about the part's origin; MuJoCo applies xfrc_applied at the COM.
+      const Vec3 tau = f.tau_W + (PartPose(f.part).translation() - com).cross(f.f_W);
+      mjtNum* x = data_->xfrc_applied + 6 * body;
+      for (int i = 0; i < 3; ++i) {
+        x[i] += k * f.f_W[i];
+        x[3 + i] += k * tau[i];
+      }
     }
   }
 
@@ -388,17 +461,24 @@ class Simulator {
     if (g.part < 0 || g.part >= static_cast<int>(part_body_.size())) return;
     grip_part_[r] = g.part;
     grasp_[r] = g;
+    recent_[r].clear();
     Weld(grip_eq_[r][g.part], TcpBodyPose(r), PartPose(g.part));
   }
 
-  // Its weld off now (and back to its own stiffness, if it was softening).
+  // Its weld off now (and its fade over, if it was fading).
   void Release(int r) {
-    if (grip_part_[r] >= 0) {
-      const int eq = grip_eq_[r][grip_part_[r]];
-      StopSoftening(eq);
-      model_->eq_active[eq] = 0;
-    }
+    StopFade(r);
+    if (grip_part_[r] >= 0) model_->eq_active[grip_eq_[r][grip_part_[r]]] = 0;
     grip_part_[r] = -1;
+  }
+
+  // The object (node) part p belongs to now, or -1.
+  int NodeOfPart(int p) const {
+    for (const auto& [node, o] : objects_) {
+      const std::vector<int>& ps = tree_.nodes[node].parts;
+      if (std::find(ps.begin(), ps.end(), p) != ps.end()) return node;
+    }
+    return -1;
   }
 
   // Where the plan has an object now: carried by its first holder, else where it was left.
@@ -612,7 +692,7 @@ class Simulator {
       Object& o = objects_[node];
       if (o.holders.size() == 1 && o.holders.front() == r) o.X_WA = ExpectedX_WA(o);
       o.holders.erase(std::remove(o.holders.begin(), o.holders.end(), r), o.holders.end());
-      // Its weld has softened away since kReleaseRamp_s before (SoftenBeforeReleases).
+      // Its wrench has faded away since kReleaseRamp_s before (FadeBeforeReleases).
       Release(r);
     };
     switch (a.type) {
@@ -694,6 +774,9 @@ class Simulator {
       const Vec3 com(data_->xipos[3 * body], data_->xipos[3 * body + 1],
                      data_->xipos[3 * body + 2]);
       const Vec3 tau = sign * tau_moved + (p_W - com).cross(f);
+      Vec6& on = mating_on_part_[side == 0 ? in.part_moved : in.part_base];
+      on.head<3>() += f;
+      on.tail<3>() += tau;
       mjtNum* x = data_->xfrc_applied + 6 * body;
       for (int k = 0; k < 3; ++k) {
         x[k] += f[k];
@@ -721,10 +804,17 @@ class Simulator {
   }
 
   // The wrench robot r's weld exerts on its part, in the TCP (grasp) frame about its origin.
-  void GripWrench(int r, Vec3& f_G, Vec3& tau_G) const {
+  // While it fades, what is left of the wrench it hands over (Fade).
+  void GripWrench(int r, Vec3& f_G, Vec3& tau_G, double t) const {
     const int p = grip_part_[r];
     Vec3 f_W, tau_W;
-    WeldWrench(grip_eq_[r][p], p, f_W, tau_W);
+    if (const Fade* fade = FadeOf(r); fade && fade->started) {
+      const double k = FadeLeft(*fade, t);
+      f_W = k * fade->f_W;
+      tau_W = k * fade->tau_W;
+    } else {
+      WeldWrench(grip_eq_[r][p], p, f_W, tau_W);
+    }
     const Iso3 X_WG = TcpBodyPose(r);
     tau_W += (PartPose(p).translation() - X_WG.translation()).cross(f_W);
     f_G = X_WG.linear().transpose() * f_W;
@@ -773,6 +863,211 @@ class Simulator {
     }
   }
 
+
+  // The best split of the load on object `node` among its supports: the robots whose welds hold
+  // its parts, and the table under it. MuJoCo's welds are rigid and its friction gives way
+  // slowly to a parallel spring (the solver's regularisation), so where an object has more than
+  // one support the welds take shares of its load that neither the plan's LP chose nor a
+  // compliant controller would give them: the split is statically indeterminate. The measured
+  // whole (every constraint force on the object's free joints, about its first part's origin)
+  // is split anew by an LP: each gripper's wrench (grasp frame, at the TCP) within lambda times
+  // its box (zero bounds floored as in BoxUtilisation), the table's force at each support point
+  // within its friction pyramid (8 edges inscribed in the cone; the normal force unbounded: a
+  // gripper may press the object onto the table). During an insertion on an object a cup holds,
+  // as the planner's "held, then mated" (wrench.h): the load without the mating wrench is held
+  // with each cup within its transport box, and what the mating adds to a cup's wrench lies in
+  // its assembly box; a two-finger gripper's whole wrench lies in its one box. Returns per robot
+  // its utilisation in the split of least lambda (bisection, 0.5%), or nothing when the object
+  // has a single support (its weld's measurement is then the answer) or the LP failed.
+  std::optional<std::map<int, double>> BestSplit(int node) {
+    const mjModel* m = model_.get();
+    const mjData* d = data_.get();
+    const std::vector<int>& parts = tree_.nodes[node].parts;
+    std::vector<char> in_object(m->nbody, 0);
+    for (int p : parts) in_object[part_body_[p]] = 1;
+    const Vec3 p0 = PartPose(parts.front()).translation();
+    // Measured: the supports' total (constraint forces), and the applied mating wrench.
+    Vec6 W = Vec6::Zero(), W_mate = Vec6::Zero();
+    for (int p : parts) {
+      const int dof = part_dof_[p];
+      const Iso3 X = PartPose(p);
+      const Vec3 f(d->qfrc_constraint[dof], d->qfrc_constraint[dof + 1], d->qfrc_constraint[dof + 2]);
+      const Vec3 tau = X.linear() * Vec3(d->qfrc_constraint[dof + 3], d->qfrc_constraint[dof + 4],
+                                         d->qfrc_constraint[dof + 5]);
+      W.head<3>() += f;
+      W.tail<3>() += tau + (X.translation() - p0).cross(f);
+      const int b = part_body_[p];
+      const Vec3 com(d->xipos[3 * b], d->xipos[3 * b + 1], d->xipos[3 * b + 2]);
+      const Vec6& on = mating_on_part_[p];
+      W_mate.head<3>() += on.head<3>();
+      W_mate.tail<3>() += on.tail<3>() + (com - p0).cross(on.head<3>());
+    }
+    // The supports' share of the mating wrench.
+    const Vec6 S_mate = -W_mate;
+    struct Holder {
+      int robot;
+      bool vacuum;
+      Mat6 A;  // grasp-frame wrench at the TCP -> world wrench about p0
+    };
+    std::vector<Holder> holders;
+    for (size_t r = 0; r < grip_part_.size(); ++r) {
+      const int p = grip_part_[r];
+      if (p < 0 || !in_object[part_body_[p]]) continue;
+      // A fading gripper's wrench is applied (a load the others take over), not split.
+      if (const Fade* fade = FadeOf(static_cast<int>(r)); fade && fade->started) continue;
+      const Iso3 G = TcpBodyPose(static_cast<int>(r));
+      Mat6 A = Mat6::Zero();
+      A.topLeftCorner<3, 3>() = G.linear();
+      A.bottomRightCorner<3, 3>() = G.linear();
+      A.bottomLeftCorner<3, 3>() = Skew(G.translation() - p0) * G.linear();
+      holders.push_back({static_cast<int>(r),
+                         scene_.robots[r].end_effector.kind == EndEffectorKind::kVacuum, A});
+    }
+    // Where the object could bear on the table: its vertices within 1 mm of the top (a part
+    // held exactly at the table's height, e.g. slid along it into its base, touches it or not
+    // by a rounding), the corners of their convex hull in the plane, each with a friction
+    // pyramid (normal up, unbounded: a gripper may press the object onto the table).
+    const SceneTable& table = scene_.table;
+    const double top = table.top_center.z();
+    std::vector<Eigen::Vector2d> low;
+    for (int p : parts) {
+      const Iso3 X = PartPose(p);
+      for (const Vec3& v : scene_.parts[p].mesh->vertices) {
+        const Vec3 w = X * v;
+        if (w.z() - top > kSupportReach_m) continue;
+        if (std::abs(w.x() - table.top_center.x()) > 0.5 * table.size.x() ||
+            std::abs(w.y() - table.top_center.y()) > 0.5 * table.size.y()) {
+          continue;
+        }
+        low.emplace_back(w.x(), w.y());
+      }
+    }
+    std::vector<Vec6> edges;  // unit-normal pyramid edges of every support point, as wrenches
+    const std::vector<Eigen::Vector2d> hull2 = ConvexHull2d(std::move(low), kMaxSupportPoints);
+    for (const Eigen::Vector2d& q : hull2) {
+      const Vec3 at = Vec3(q.x(), q.y(), top) - p0;
+      for (int k = 0; k < 8; ++k) {
+        const double th = k * M_PI / 4.0;
+        const Vec3 e = Vec3::UnitZ() + table.friction * Vec3(std::cos(th), std::sin(th), 0.0);
+        Vec6 w;
+        w << e, at.cross(e);
+        edges.push_back(w);
+      }
+    }
+    if (holders.empty() || holders.size() + (edges.empty() ? 0 : 1) < 2) return std::nullopt;
+    const bool staged = S_mate.norm() > 1e-9 &&
+                        std::any_of(holders.begin(), holders.end(),
+                                    [](const Holder& h) { return h.vacuum; });
+    const double fN = options_.zero_limit_force_N, fNm = options_.zero_limit_torque_Nm;
+    auto bounds = [&](const WrenchBox& box) {
+      Vec6 b;
+      for (int i = 0; i < 3; ++i) {
+        b[i] = std::max(box.force_N[i], fN);
+        b[3 + i] = std::max(box.torque_Nm[i], fNm);
+      }
+      return b;
+    };
+    // Columns: per holder its wrench (staged: two parts, below), then the support points' edges
+    // (staged: their whole force, then their force while only holding).
+    const int rows = staged ? 12 : 6;
+    const int per_holder = staged ? 12 : 6;
+    const int nh = static_cast<int>(holders.size());
+    const int ne = static_cast<int>(edges.size());
+    const int cols = nh * per_holder + ne * (staged ? 2 : 1);
+    LpProblem& lp = lp_problem_;
+    lp.Reset(rows, cols);
+    for (int i = 0; i < 6; ++i) lp.rhs[i] = W[i];
+    if (staged) {
+      for (int i = 0; i < 6; ++i) lp.rhs[6 + i] = W[i] - S_mate[i];
+    }
+    std::vector<Vec6> box_of(static_cast<size_t>(nh * (staged ? 2 : 1)));  // per wrench column
+    for (int h = 0; h < nh; ++h) {
+      const Holder& H = holders[h];
+      const WrenchLimits& lim = limits_[H.robot];
+      for (int part = 0; part < (staged ? 2 : 1); ++part) {
+        // Rows 0-5: the whole load; staged, rows 6-11: the load without the mating wrench.
+        // A cup: part 0 holds (in both), part 1 is what the mating adds (in the whole only).
+        // A two-finger gripper: part 0 its whole wrench (whole), part 1 its free share of the
+        // holding (rows 6-11 only).
+        const int c0 = h * per_holder + 6 * part;
+        for (int j = 0; j < 6; ++j) {
+          double* col = lp.column(c0 + j);
+          const bool counts_in_total = H.vacuum || part == 0;
+          const bool counts_in_hold = staged && (H.vacuum ? part == 0 : part == 1);
+          for (int i = 0; i < 6; ++i) {
+            if (counts_in_total) col[i] = H.A(i, j);
+            if (counts_in_hold) col[6 + i] = H.A(i, j);
+          }
+        }
+        Vec6 b;
+        if (!H.vacuum) {
+          b = part == 0 ? bounds(lim.two_finger)
+                        : Vec6::Constant(std::numeric_limits<double>::infinity());
+        } else {
+          b = part == 0 ? bounds(lim.vacuum_transport) : bounds(lim.vacuum_assembly);
+        }
+        box_of[static_cast<size_t>(h * (staged ? 2 : 1) + part)] = b;
+      }
+    }
+    const int e0 = nh * per_holder;
+    for (int k = 0; k < ne; ++k) {
+      for (int part = 0; part < (staged ? 2 : 1); ++part) {
+        double* col = lp.column(e0 + part * ne + k);
+        for (int i = 0; i < 6; ++i) {
+          // part 0: the contacts' whole force, part 1: their force while only holding.
+          col[(part == 0 ? 0 : 6) + i] = edges[k][i];
+        }
+      }
+    }
+    auto feasible = [&](double lambda) {
+      for (int h = 0; h < nh; ++h) {
+        for (int part = 0; part < (staged ? 2 : 1); ++part) {
+          const Vec6& b = box_of[static_cast<size_t>(h * (staged ? 2 : 1) + part)];
+          for (int j = 0; j < 6; ++j) {
+            const int c = h * per_holder + 6 * part + j;
+            lp.lower[c] = -lambda * b[j];
+            lp.upper[c] = lambda * b[j];
+          }
+        }
+      }
+      return lp_->Solve(lp, lp_solution_) == LpStatus::kOptimal;
+    };
+    // The least lambda, by bisection between a feasible and an infeasible one.
+    double lo = 0.0, hi = 1.0;
+    if (!feasible(hi)) {
+      lo = hi;
+      while (hi < 1e4) {
+        hi *= 2.0;
+        if (feasible(hi)) break;
+        lo = hi;
+      }
+      if (hi >= 1e4) return std::nullopt;
+    }
+    while (hi - lo > 0.005 * hi) {
+      const double mid = 0.5 * (lo + hi);
+      if (feasible(mid)) {
+        hi = mid;
+      } else {
+        lo = mid;
+      }
+    }
+    if (!feasible(hi)) return std::nullopt;
+    ++report_.split_measurements;
+    std::map<int, double> u;
+    for (int h = 0; h < nh; ++h) {
+      double worst = 0.0;
+      for (int part = 0; part < (staged ? 2 : 1); ++part) {
+        const Vec6& b = box_of[static_cast<size_t>(h * (staged ? 2 : 1) + part)];
+        for (int j = 0; j < 6; ++j) {
+          if (!std::isfinite(b[j])) continue;
+          worst = std::max(worst, std::abs(lp_solution_.x[h * per_holder + 6 * part + j]) / b[j]);
+        }
+      }
+      u[holders[h].robot] = worst;
+    }
+    return u;
+  }
+
   void Measure(double t, const std::vector<int>& inserting) {
     const int current = CurrentAction();
     // Grippers against their limits.
@@ -781,10 +1076,27 @@ class Simulator {
       if (grip_part_[r] < 0) {
         was_inserting_[r] = false;
         prev_f_[r] = prev_tau_[r] = Vec3::Zero();
+        recent_[r].clear();
         continue;
       }
       Vec3 f, tau;
-      GripWrench(r, f, tau);
+      GripWrench(r, f, tau, t);
+      // Averaged over the last options_.average_s (see SimOptions).
+      {
+        std::deque<Vec6>& recent = recent_[r];
+        Vec6 w;
+        w << f, tau;
+        recent.push_back(w);
+        const double sample_s = options_.sample_every * model_->opt.timestep;
+        const size_t keep = static_cast<size_t>(
+            std::max(1.0, std::round(std::max(0.0, options_.average_s) / sample_s)));
+        while (recent.size() > keep) recent.pop_front();
+        Vec6 mean = Vec6::Zero();
+        for (const Vec6& x : recent) mean += x;
+        mean /= static_cast<double>(recent.size());
+        f = mean.head<3>();
+        tau = mean.tail<3>();
+      }
       int insert_action = -1;
       for (int i : inserting) {
         const auto& rs = plan_.actions[i].robots;
@@ -826,6 +1138,24 @@ class Simulator {
                      BoxUtilisation(add_f, add_tau, lim.vacuum_assembly, fN, fNm));
       }
       was_inserting_[r] = insert_action >= 0;
+      bool split = false;
+      if (u > 1.0) {
+        // Beyond its limits as MuJoCo split the load: judged by the best split when the
+        // object has other supports (BestSplit).
+        const int node = NodeOfPart(grip_part_[r]);
+        if (node >= 0) {
+          if (split_at_ != t) {
+            split_at_ = t;
+            split_.clear();
+          }
+          auto it = split_.find(node);
+          if (it == split_.end()) it = split_.emplace(node, BestSplit(node)).first;
+          if (it->second && it->second->count(r)) {
+            u = it->second->at(r);
+            split = true;
+          }
+        }
+      }
       prev_f_[r] = f;
       prev_tau_[r] = tau;
       if (const char* who = std::getenv("WRAP_SIM_TRACE"); who && scene_.robots[r].name == who) {
@@ -847,7 +1177,9 @@ class Simulator {
                "robot '" + scene_.robots[r].name + "' at " + Num(100 * u) + "% of its " +
                    (vacuum ? (insert_action >= 0 ? "vacuum assembly/transport" : "vacuum transport")
                            : "two-finger") +
-                   " limits (force " + Num(f.x()) + ", " + Num(f.y()) + ", " + Num(f.z()) +
+                   " limits (" + (split ? "in the best split of the load among its object's "
+                                          "supports; its weld measured " : "") +
+                   "force " + Num(f.x()) + ", " + Num(f.y()) + ", " + Num(f.z()) +
                    " N, torque " + Num(tau.x()) + ", " + Num(tau.y()) + ", " + Num(tau.z()) +
                    " N m in the grasp frame)",
                t);
@@ -921,9 +1253,10 @@ class Simulator {
       }
       if (report_.failure) break;
       SetTcps(t);
-      SoftenBeforeReleases(t);
-      SoftenReleases(t);
+      FadeBeforeReleases(t);
       mju_zero(data_->xfrc_applied, 6 * model_->nbody);
+      for (Vec6& w : mating_on_part_) w.setZero();
+      ApplyFades(t);
       const std::vector<int> inserting = Insertions(t);
       for (int i : inserting) ApplyMating(i);
       mj_step(model_.get(), data_.get());
@@ -977,12 +1310,9 @@ class Simulator {
   std::vector<PlanGrasp> grasp_;           // per robot, its current grasp
   std::vector<Vec3> hold_f_, hold_tau_;    // per robot, wrench when its insertion began
   std::vector<Vec3> prev_f_, prev_tau_;    // per robot, its last measured wrench
-  struct Releasing {
-    int eq;             // the weld
-    double t0;          // let go of from [s]
-    double time_const;  // its own solref time constant [s]
-  };
-  std::vector<Releasing> releasing_;     // welds being let go of
+  std::vector<Fade> fades_;              // grippers being let go of
+  std::vector<std::deque<Vec6>> recent_;  // per robot, its last measured wrenches (averaged)
+  std::vector<Vec6> mating_on_part_;     // per part, the mating wrench applied now (about its COM)
   std::vector<bool> was_inserting_;      // per robot
   std::map<int, Interface> interfaces_;  // per assemble action
   struct Join {
@@ -992,6 +1322,11 @@ class Simulator {
   };
   std::vector<Join> joins_;        // connections made so far
   std::map<int, Object> objects_;  // by node id
+  std::unique_ptr<LpBackend> lp_ = MakeDenseSimplexBackend();  // BestSplit's
+  LpProblem lp_problem_;
+  LpSolution lp_solution_;
+  double split_at_ = -1.0;                                 // when split_ was computed
+  std::map<int, std::optional<std::map<int, double>>> split_;  // BestSplit by node at split_at_
   std::vector<int> order_;         // actions by end_s
   size_t next_event_ = 0;
   double makespan_ = 0.0;
@@ -1016,6 +1351,9 @@ Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check
   const AssemblyTree& tree = *check.tree;
   if (!(options.frame_interval_s > 0.0) || !std::isfinite(options.frame_interval_s)) {
     return bad("sim: the frame interval must be a positive number of seconds");
+  }
+  if (!(options.average_s >= 0.0) || !std::isfinite(options.average_s)) {
+    return bad("sim: the averaging window must be a number of seconds >= 0");
   }
   // A plan without motion: its keyframes replayed one action at a time.
   std::optional<Plan> timed;

@@ -38,6 +38,11 @@ struct SimOptions {
   double zero_limit_force_N = 1.0;
   double zero_limit_torque_Nm = 0.05;  ///< Same for torques [N m].
   int sample_every = 5;                ///< Measure wrenches and drift every this many steps.
+  /// A gripper's wrench is judged averaged over this long [s] (its last measurements): a
+  /// kinematic robot's acceleration steps where its trajectory's pieces meet, and MuJoCo's weld
+  /// answers a step with a spike of one or two samples (a carried chair's gripper: 53% -> 103%
+  /// -> 85% within 20 ms) that no gripper's pads would feel. 0: every sample alone.
+  double average_s = 0.02;
   /// Judge collisions (robots with robots, robots with parts they neither hold nor are grasping
   /// or releasing, held parts with anything but their mating partner during its insertion, a
   /// held part into the table). Only with trajectories: a keyframe replay is not collision-free
@@ -111,6 +116,10 @@ struct SimReport {
   std::string motion = "trajectories";
   bool collisions_judged = false;  ///< Collisions were checked during the run.
   long long collision_checks = 0;  ///< Moments checked for collisions.
+  /// Measurements in which a gripper beyond its limits as MuJoCo's rigid welds split its
+  /// object's load was judged by the best split among the object's supports instead (its other
+  /// grippers, its table contacts: an LP, see simulate.cpp BestSplit). 0 when none.
+  long long split_measurements = 0;
   std::vector<std::string> notes;  ///< What the run approximated (keyframe replay).
   std::vector<std::string> warnings;            ///< MuJoCo warnings, approximated meshes.
 };
