@@ -17,6 +17,7 @@
 #include "sim/mujoco_model.h"
 #include "sim/scene.h"
 #include "verify/detail/collisions.h"
+#include "verify/detail/best_split.h"
 #include "verify/detail/keyframe_replay.h"
 #include "wrench/lp.h"
 #include "wrench/wrench.h"
@@ -34,7 +35,6 @@ constexpr double kReleaseRamp_s = 0.1;
 constexpr double kSupportReach_m = 0.001;
 constexpr size_t kMaxSupportPoints = 16;
 
-using Mat6 = Eigen::Matrix<double, 6, 6>;
 
 Mat3 Skew(const Vec3& v) {
   Mat3 S;
@@ -886,47 +886,45 @@ class Simulator {
     std::vector<char> in_object(m->nbody, 0);
     for (int p : parts) in_object[part_body_[p]] = 1;
     const Vec3 p0 = PartPose(parts.front()).translation();
-    // Measured: the supports' total (constraint forces), and the applied mating wrench.
-    Vec6 W = Vec6::Zero(), W_mate = Vec6::Zero();
+    detail::SplitQuery q;
+    // Measured: the supports' whole (constraint forces), and the applied mating wrench.
+    Vec6 W_mate = Vec6::Zero();
     for (int p : parts) {
       const int dof = part_dof_[p];
       const Iso3 X = PartPose(p);
-      const Vec3 f(d->qfrc_constraint[dof], d->qfrc_constraint[dof + 1], d->qfrc_constraint[dof + 2]);
+      const Vec3 f(d->qfrc_constraint[dof], d->qfrc_constraint[dof + 1],
+                   d->qfrc_constraint[dof + 2]);
       const Vec3 tau = X.linear() * Vec3(d->qfrc_constraint[dof + 3], d->qfrc_constraint[dof + 4],
                                          d->qfrc_constraint[dof + 5]);
-      W.head<3>() += f;
-      W.tail<3>() += tau + (X.translation() - p0).cross(f);
+      q.whole.head<3>() += f;
+      q.whole.tail<3>() += tau + (X.translation() - p0).cross(f);
       const int b = part_body_[p];
       const Vec3 com(d->xipos[3 * b], d->xipos[3 * b + 1], d->xipos[3 * b + 2]);
       const Vec6& on = mating_on_part_[p];
       W_mate.head<3>() += on.head<3>();
       W_mate.tail<3>() += on.tail<3>() + (com - p0).cross(on.head<3>());
     }
-    // The supports' share of the mating wrench.
-    const Vec6 S_mate = -W_mate;
-    struct Holder {
-      int robot;
-      bool vacuum;
-      Mat6 A;  // grasp-frame wrench at the TCP -> world wrench about p0
-    };
-    std::vector<Holder> holders;
+    q.mating = -W_mate;
+    std::vector<int> robots;
     for (size_t r = 0; r < grip_part_.size(); ++r) {
       const int p = grip_part_[r];
       if (p < 0 || !in_object[part_body_[p]]) continue;
       // A fading gripper's wrench is applied (a load the others take over), not split.
       if (const Fade* fade = FadeOf(static_cast<int>(r)); fade && fade->started) continue;
       const Iso3 G = TcpBodyPose(static_cast<int>(r));
-      Mat6 A = Mat6::Zero();
-      A.topLeftCorner<3, 3>() = G.linear();
-      A.bottomRightCorner<3, 3>() = G.linear();
-      A.bottomLeftCorner<3, 3>() = Skew(G.translation() - p0) * G.linear();
-      holders.push_back({static_cast<int>(r),
-                         scene_.robots[r].end_effector.kind == EndEffectorKind::kVacuum, A});
+      detail::SplitHolder h;
+      h.A.setZero();
+      h.A.topLeftCorner<3, 3>() = G.linear();
+      h.A.bottomRightCorner<3, 3>() = G.linear();
+      h.A.bottomLeftCorner<3, 3>() = Skew(G.translation() - p0) * G.linear();
+      h.vacuum = scene_.robots[r].end_effector.kind == EndEffectorKind::kVacuum;
+      h.limits = limits_[r];
+      q.holders.push_back(h);
+      robots.push_back(static_cast<int>(r));
     }
-    // Where the object could bear on the table: its vertices within 1 mm of the top (a part
-    // held exactly at the table's height, e.g. slid along it into its base, touches it or not
-    // by a rounding), the corners of their convex hull in the plane, each with a friction
-    // pyramid (normal up, unbounded: a gripper may press the object onto the table).
+    // Where the object could bear on the table: its vertices within kSupportReach_m of the top
+    // (a part held exactly at the table's height, e.g. slid along it into its base, touches it
+    // or not by a rounding), the corners of their convex hull in the plane.
     const SceneTable& table = scene_.table;
     const double top = table.top_center.z();
     std::vector<Eigen::Vector2d> low;
@@ -942,129 +940,17 @@ class Simulator {
         low.emplace_back(w.x(), w.y());
       }
     }
-    std::vector<Vec6> edges;  // unit-normal pyramid edges of every support point, as wrenches
-    const std::vector<Eigen::Vector2d> hull2 = ConvexHull2d(std::move(low), kMaxSupportPoints);
-    for (const Eigen::Vector2d& q : hull2) {
-      const Vec3 at = Vec3(q.x(), q.y(), top) - p0;
-      for (int k = 0; k < 8; ++k) {
-        const double th = k * M_PI / 4.0;
-        const Vec3 e = Vec3::UnitZ() + table.friction * Vec3(std::cos(th), std::sin(th), 0.0);
-        Vec6 w;
-        w << e, at.cross(e);
-        edges.push_back(w);
-      }
+    for (const Eigen::Vector2d& c : ConvexHull2d(std::move(low), kMaxSupportPoints)) {
+      q.support_points.push_back(Vec3(c.x(), c.y(), top) - p0);
     }
-    if (holders.empty() || holders.size() + (edges.empty() ? 0 : 1) < 2) return std::nullopt;
-    const bool staged = S_mate.norm() > 1e-9 &&
-                        std::any_of(holders.begin(), holders.end(),
-                                    [](const Holder& h) { return h.vacuum; });
-    const double fN = options_.zero_limit_force_N, fNm = options_.zero_limit_torque_Nm;
-    auto bounds = [&](const WrenchBox& box) {
-      Vec6 b;
-      for (int i = 0; i < 3; ++i) {
-        b[i] = std::max(box.force_N[i], fN);
-        b[3 + i] = std::max(box.torque_Nm[i], fNm);
-      }
-      return b;
-    };
-    // Columns: per holder its wrench (staged: two parts, below), then the support points' edges
-    // (staged: their whole force, then their force while only holding).
-    const int rows = staged ? 12 : 6;
-    const int per_holder = staged ? 12 : 6;
-    const int nh = static_cast<int>(holders.size());
-    const int ne = static_cast<int>(edges.size());
-    const int cols = nh * per_holder + ne * (staged ? 2 : 1);
-    LpProblem& lp = lp_problem_;
-    lp.Reset(rows, cols);
-    for (int i = 0; i < 6; ++i) lp.rhs[i] = W[i];
-    if (staged) {
-      for (int i = 0; i < 6; ++i) lp.rhs[6 + i] = W[i] - S_mate[i];
-    }
-    std::vector<Vec6> box_of(static_cast<size_t>(nh * (staged ? 2 : 1)));  // per wrench column
-    for (int h = 0; h < nh; ++h) {
-      const Holder& H = holders[h];
-      const WrenchLimits& lim = limits_[H.robot];
-      for (int part = 0; part < (staged ? 2 : 1); ++part) {
-        // Rows 0-5: the whole load; staged, rows 6-11: the load without the mating wrench.
-        // A cup: part 0 holds (in both), part 1 is what the mating adds (in the whole only).
-        // A two-finger gripper: part 0 its whole wrench (whole), part 1 its free share of the
-        // holding (rows 6-11 only).
-        const int c0 = h * per_holder + 6 * part;
-        for (int j = 0; j < 6; ++j) {
-          double* col = lp.column(c0 + j);
-          const bool counts_in_total = H.vacuum || part == 0;
-          const bool counts_in_hold = staged && (H.vacuum ? part == 0 : part == 1);
-          for (int i = 0; i < 6; ++i) {
-            if (counts_in_total) col[i] = H.A(i, j);
-            if (counts_in_hold) col[6 + i] = H.A(i, j);
-          }
-        }
-        Vec6 b;
-        if (!H.vacuum) {
-          b = part == 0 ? bounds(lim.two_finger)
-                        : Vec6::Constant(std::numeric_limits<double>::infinity());
-        } else {
-          b = part == 0 ? bounds(lim.vacuum_transport) : bounds(lim.vacuum_assembly);
-        }
-        box_of[static_cast<size_t>(h * (staged ? 2 : 1) + part)] = b;
-      }
-    }
-    const int e0 = nh * per_holder;
-    for (int k = 0; k < ne; ++k) {
-      for (int part = 0; part < (staged ? 2 : 1); ++part) {
-        double* col = lp.column(e0 + part * ne + k);
-        for (int i = 0; i < 6; ++i) {
-          // part 0: the contacts' whole force, part 1: their force while only holding.
-          col[(part == 0 ? 0 : 6) + i] = edges[k][i];
-        }
-      }
-    }
-    auto feasible = [&](double lambda) {
-      for (int h = 0; h < nh; ++h) {
-        for (int part = 0; part < (staged ? 2 : 1); ++part) {
-          const Vec6& b = box_of[static_cast<size_t>(h * (staged ? 2 : 1) + part)];
-          for (int j = 0; j < 6; ++j) {
-            const int c = h * per_holder + 6 * part + j;
-            lp.lower[c] = -lambda * b[j];
-            lp.upper[c] = lambda * b[j];
-          }
-        }
-      }
-      return lp_->Solve(lp, lp_solution_) == LpStatus::kOptimal;
-    };
-    // The least lambda, by bisection between a feasible and an infeasible one.
-    double lo = 0.0, hi = 1.0;
-    if (!feasible(hi)) {
-      lo = hi;
-      while (hi < 1e4) {
-        hi *= 2.0;
-        if (feasible(hi)) break;
-        lo = hi;
-      }
-      if (hi >= 1e4) return std::nullopt;
-    }
-    while (hi - lo > 0.005 * hi) {
-      const double mid = 0.5 * (lo + hi);
-      if (feasible(mid)) {
-        hi = mid;
-      } else {
-        lo = mid;
-      }
-    }
-    if (!feasible(hi)) return std::nullopt;
+    q.friction = table.friction;
+    q.floor_N = options_.zero_limit_force_N;
+    q.floor_Nm = options_.zero_limit_torque_Nm;
+    auto split = detail::BestSplit(q, *lp_, lp_problem_, lp_solution_);
+    if (!split) return std::nullopt;
     ++report_.split_measurements;
     std::map<int, double> u;
-    for (int h = 0; h < nh; ++h) {
-      double worst = 0.0;
-      for (int part = 0; part < (staged ? 2 : 1); ++part) {
-        const Vec6& b = box_of[static_cast<size_t>(h * (staged ? 2 : 1) + part)];
-        for (int j = 0; j < 6; ++j) {
-          if (!std::isfinite(b[j])) continue;
-          worst = std::max(worst, std::abs(lp_solution_.x[h * per_holder + 6 * part + j]) / b[j]);
-        }
-      }
-      u[holders[h].robot] = worst;
-    }
+    for (size_t h = 0; h < robots.size(); ++h) u[robots[h]] = (*split)[h];
     return u;
   }
 
