@@ -821,7 +821,10 @@ class Simulator {
     tau_G = X_WG.linear().transpose() * tau_W;
   }
 
-  // Friction use of every part-table (or floor) contact.
+  // Friction use of every resting part on the table (or floor): the resultant of its contacts'
+  // tangential forces over mu times their normal forces (MuJoCo spreads a part's load over its
+  // contacts as its solver likes, and with elliptic cones leaves some at their cone's edge while
+  // the part stands still: a single contact's use says little).
   void MeasureTable() {
     const mjModel* m = model_.get();
     const mjData* d = data_.get();
@@ -832,14 +835,31 @@ class Simulator {
       if (o.holders.empty()) continue;
       for (int p : tree_.nodes[node].parts) held_body[part_body_[p]] = 1;
     }
+    struct Sum {
+      double normal = 0.0, mu = 0.0;
+      Vec3 tangential = Vec3::Zero();
+    };
+    std::map<int, Sum> sums;  // by part body
     for (int i = 0; i < d->ncon; ++i) {
       const mjContact& c = d->contact[i];
-      if (held_body[m->geom_bodyid[c.geom1]] || held_body[m->geom_bodyid[c.geom2]]) continue;
+      const int b1 = m->geom_bodyid[c.geom1], b2 = m->geom_bodyid[c.geom2];
+      if (held_body[b1] || held_body[b2]) continue;
       if (c.exclude != 0 || c.efc_address < 0 || c.friction[0] <= 0.0) continue;
       mjtNum f[6];
       mj_contactForce(m, d, i, f);
-      if (f[0] < kMinNormal_N) continue;
-      const double use = std::hypot(f[1], f[2]) / (c.friction[0] * f[0]);
+      // The force on geom2 in the contact frame (normal from geom1 to geom2): the part's.
+      const int part = std::count(part_body_.begin(), part_body_.end(), b2) ? b2 : b1;
+      const double sign = part == b2 ? 1.0 : -1.0;
+      Sum& sum = sums[part];
+      sum.normal += f[0];
+      sum.mu = c.friction[0];
+      for (int k = 0; k < 3; ++k) {
+        sum.tangential[k] += sign * (f[1] * c.frame[3 + k] + f[2] * c.frame[6 + k]);
+      }
+    }
+    for (const auto& [body, sum] : sums) {
+      if (sum.normal < kMinNormal_N) continue;
+      const double use = sum.tangential.norm() / (sum.mu * sum.normal);
       report_.peak.table_friction = std::max(report_.peak.table_friction, use);
     }
   }

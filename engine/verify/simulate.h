@@ -76,9 +76,9 @@ struct SimUtilisation {
   /// (T_pq, a box in the connection frame: origin at the interface, z along the insertion axis).
   /// Reported, not a failure.
   double connection = -1.0;
-  /// The table's support: the largest friction use |f_t| / (mu f_n) of a contact between the
-  /// table and a part nobody holds, carrying more than 0.05 N (1: sliding). Reported, not a failure
-  /// (a part that slides is caught as "no support").
+  /// The table's support: the largest friction use |F_t| / (mu F_n) of a part nobody holds, over
+  /// the resultant of its contacts with the table carrying more than 0.05 N (1: sliding).
+  /// Reported, not a failure (a part that slides is caught as "no support").
   double table_friction = -1.0;
 };
 

@@ -170,7 +170,13 @@ TEST(Load, QuickProjectsPlannedFiftyTimesKeepMemoryFlatAndPlansTheSame) {
 }
 
 TEST(Load, SlowProjectsPlannedRepeatedlyKeepMemoryFlatAndPlansTheSame) {
+#if defined(__SANITIZE_ADDRESS__)
+  // Under ASan cross_openarm's task plan alone takes about 370 s on two cores (ExamplePlan plans
+  // it in that build); twice more would not fit the test's 1500 s. The normal build plans it.
+  PlanRepeatedly({"stool", "chair", "cube", "cube_2x2x3"}, 2);
+#else
   PlanRepeatedly({"stool", "chair", "cross_openarm", "cube", "cube_2x2x3"}, 2);
+#endif
 }
 
 }  // namespace

