@@ -36,6 +36,16 @@ Vec6 Bounds(const WrenchBox& box, double floor_N, double floor_Nm) {
 
 }  // namespace
 
+Eigen::Matrix<double, 6, 6> GraspWrenchToWorld(const Mat3& R_WG, const Vec3& p_OG) {
+  Mat3 skew;
+  skew << 0.0, -p_OG.z(), p_OG.y(), p_OG.z(), 0.0, -p_OG.x(), -p_OG.y(), p_OG.x(), 0.0;
+  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
+  A.topLeftCorner<3, 3>() = R_WG;
+  A.bottomRightCorner<3, 3>() = R_WG;
+  A.bottomLeftCorner<3, 3>() = skew * R_WG;
+  return A;
+}
+
 std::optional<std::vector<double>> BestSplit(const SplitQuery& q, LpBackend& backend,
                                              LpProblem& lp, LpSolution& solution) {
   const int nh = static_cast<int>(q.holders.size());

@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "core/frames.h"
+#include "geometry/convex_hull.h"
 #include "robot/kinematics.h"
 #include "sim/mjcf.h"
 #include "sim/mujoco_model.h"
@@ -34,41 +35,6 @@ constexpr double kReleaseRamp_s = 0.1;
 // many corners of their hull are used.
 constexpr double kSupportReach_m = 0.001;
 constexpr size_t kMaxSupportPoints = 16;
-
-
-Mat3 Skew(const Vec3& v) {
-  Mat3 S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
-
-// The corners of the convex hull of `points` (Andrew's monotone chain), counter-clockwise, at
-// most `max_corners` of them (evenly picked when there are more).
-std::vector<Eigen::Vector2d> ConvexHull2d(std::vector<Eigen::Vector2d> points, size_t max_corners) {
-  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
-  points.erase(std::unique(points.begin(), points.end()), points.end());
-  if (points.size() < 3) return points;
-  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
-  };
-  std::vector<Eigen::Vector2d> hull(2 * points.size());
-  size_t k = 0;
-  for (size_t i = 0; i < points.size(); ++i) {
-    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
-    hull[k++] = points[i];
-  }
-  for (size_t i = points.size() - 1, lower = k + 1; i > 0; --i) {
-    while (k >= lower && cross(hull[k - 2], hull[k - 1], points[i - 1]) <= 0) --k;
-    hull[k++] = points[i - 1];
-  }
-  hull.resize(k - 1);
-  if (hull.size() <= max_corners) return hull;
-  std::vector<Eigen::Vector2d> picked;
-  for (size_t i = 0; i < max_corners; ++i) picked.push_back(hull[i * hull.size() / max_corners]);
-  return picked;
-}
 
 double AngleOf(const Mat3& R) { return std::abs(Eigen::AngleAxisd(R).angle()); }
 
@@ -883,22 +849,12 @@ class Simulator {
     }
   }
 
-
-  // The best split of the load on object `node` among its supports: the robots whose welds hold
-  // its parts, and the table under it. MuJoCo's welds are rigid and its friction gives way
-  // slowly to a parallel spring (the solver's regularisation), so where an object has more than
-  // one support the welds take shares of its load that neither the plan's LP chose nor a
-  // compliant controller would give them: the split is statically indeterminate. The measured
-  // whole (every constraint force on the object's free joints, about its first part's origin)
-  // is split anew by an LP: each gripper's wrench (grasp frame, at the TCP) within lambda times
-  // its box (zero bounds floored as in BoxUtilisation), the table's force at each support point
-  // within its friction pyramid (8 edges inscribed in the cone; the normal force unbounded: a
-  // gripper may press the object onto the table). During an insertion on an object a cup holds,
-  // as the planner's "held, then mated" (wrench.h): the load without the mating wrench is held
-  // with each cup within its transport box, and what the mating adds to a cup's wrench lies in
-  // its assembly box; a two-finger gripper's whole wrench lies in its one box. Returns per robot
-  // its utilisation in the split of least lambda (bisection, 0.5%), or nothing when the object
-  // has a single support (its weld's measurement is then the answer) or the LP failed.
+  // The best split of the load on object `node` among its supports (detail/best_split.h): the
+  // robots whose welds hold its parts (not one fading out: its wrench is applied, a load the
+  // others take over) and the table under it. The measured whole is every constraint force on
+  // the object's free joints, about its first part's origin. Per robot its utilisation in that
+  // split, or nothing when the object has a single support (its weld's measurement is then the
+  // answer) or the LP failed.
   std::optional<std::map<int, double>> BestSplit(int node) {
     const mjModel* m = model_.get();
     const mjData* d = data_.get();
@@ -929,14 +885,10 @@ class Simulator {
     for (size_t r = 0; r < grip_part_.size(); ++r) {
       const int p = grip_part_[r];
       if (p < 0 || !in_object[part_body_[p]]) continue;
-      // A fading gripper's wrench is applied (a load the others take over), not split.
       if (const Fade* fade = FadeOf(static_cast<int>(r)); fade && fade->started) continue;
       const Iso3 G = TcpBodyPose(static_cast<int>(r));
       detail::SplitHolder h;
-      h.A.setZero();
-      h.A.topLeftCorner<3, 3>() = G.linear();
-      h.A.bottomRightCorner<3, 3>() = G.linear();
-      h.A.bottomLeftCorner<3, 3>() = Skew(G.translation() - p0) * G.linear();
+      h.A = detail::GraspWrenchToWorld(G.linear(), G.translation() - p0);
       h.vacuum = scene_.robots[r].end_effector.kind == EndEffectorKind::kVacuum;
       h.limits = limits_[r];
       q.holders.push_back(h);
@@ -960,7 +912,10 @@ class Simulator {
         low.emplace_back(w.x(), w.y());
       }
     }
-    for (const Eigen::Vector2d& c : ConvexHull2d(std::move(low), kMaxSupportPoints)) {
+    const std::vector<int> hull = ConvexHull2d(low);
+    const size_t n = hull.size(), used = std::min(n, kMaxSupportPoints);  // evenly picked
+    for (size_t i = 0; i < used; ++i) {
+      const Eigen::Vector2d& c = low[hull[i * n / used]];
       q.support_points.push_back(Vec3(c.x(), c.y(), top) - p0);
     }
     q.friction = table.friction;

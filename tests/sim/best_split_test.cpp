@@ -10,17 +10,10 @@
 namespace wrap::detail {
 namespace {
 
-using Mat6 = Eigen::Matrix<double, 6, 6>;
-
 // A gripper at `p` (relative to O) with grasp axes `R` (columns: G's axes in the world).
 SplitHolder Holder(const Vec3& p, const Mat3& R, bool vacuum) {
   SplitHolder h;
-  h.A.setZero();
-  h.A.topLeftCorner<3, 3>() = R;
-  h.A.bottomRightCorner<3, 3>() = R;
-  Mat3 S;
-  S << 0.0, -p.z(), p.y(), p.z(), 0.0, -p.x(), -p.y(), p.x(), 0.0;
-  h.A.bottomLeftCorner<3, 3>() = S * R;
+  h.A = GraspWrenchToWorld(R, p);
   h.vacuum = vacuum;
   return h;
 }

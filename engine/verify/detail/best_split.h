@@ -46,6 +46,9 @@ struct SplitQuery {
   double floor_Nm = 0.05;  ///< A zero torque bound counts as this [N m].
 };
 
+/// SplitHolder::A of a grasp frame with axes R_WG (columns in the world) at p_OG from O.
+Eigen::Matrix<double, 6, 6> GraspWrenchToWorld(const Mat3& R_WG, const Vec3& p_OG);
+
 /// Per holder (in order), its utilisation in the split of least lambda (its largest
 /// |component| / bound; lambda found by bisection to 0.5%, or below 0.1%); nothing when the query
 /// has no holder, a single support (one holder and no support point: its wrench is determined),
