@@ -159,11 +159,20 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
                     "limited to 4x this")
       ->check(CLI::PositiveNumber);
   bench->add_flag("--keep-plans", bench_args.keep_plans, "Keep every plan JSON under plans/");
+  bench->add_flag("--rerun-loaded", bench_args.rerun_loaded,
+                  "Resuming: run again the runs made while the machine was loaded (more threads "
+                  "ready to run than cores; marked in the report)");
+  bench->add_flag("--dry-run", bench_args.dry_run,
+                  "Only list this shard's runs and the longest it can take; run nothing");
   CLI::App* bench_merge = bench->add_subcommand(
-      "merge", "Combine the results of shard folders into one results.csv and report");
+      "merge",
+      "Combine the results of shard folders into one results.csv and report; refuses folders "
+      "of different revisions or settings, and missing or unfinished shards");
   bench_merge->add_option("DIR", bench_args.merge_dirs, "Shard output folders")->required();
   std::string merge_output;
   bench_merge->add_option("-o,--output", merge_output, "Output folder")->required();
+  bench_merge->add_flag("--partial", bench_args.partial,
+                        "Merge although shards are missing or unfinished (the report says which)");
 
   // No subcommand: the GUI, optionally on a project, with its headless hooks.
   GuiArgs gui;

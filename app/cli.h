@@ -126,13 +126,17 @@ struct BenchArgs {
   double hard_limit_s = 0.0;             ///< --hard-limit [s] per child; 0: automatic.
   long long memory_limit_mib = 4096;     ///< --memory-limit [MiB] of each planner run.
   bool keep_plans = false;               ///< --keep-plans.
+  bool rerun_loaded = false;             ///< --rerun-loaded.
+  bool dry_run = false;                  ///< --dry-run: list the shard's runs, run nothing.
   std::vector<std::string> merge_dirs;   ///< `bench merge DIR...`; empty: run a suite.
+  bool partial = false;                  ///< `bench merge --partial`.
 };
 
 /// `wrap bench --suite S -o DIR`: runs the suite's planner runs in child processes (time and
 /// memory limits; timeouts, out-of-memory and crashes recorded), writes runs/, results.csv,
-/// report.md and report.html; `wrap bench merge DIR... -o OUT` combines shards. Exit 0, 1
-/// interrupted (resume by running again), 2 bad input, 3 internal.
+/// report.md and report.html; `wrap bench merge DIR... -o OUT` combines shards (refusing shards
+/// that do not belong together). Exit 0, 1 interrupted (resume by running again), 2 bad input
+/// (also: a folder in use, or of another shard or setting), 3 internal.
 int Bench(const BenchArgs& args, std::ostream& out, std::ostream& err);
 
 /// Arguments of the GUI (`wrap` without a subcommand).

@@ -1,9 +1,12 @@
 // `wrap bench`: runs a benchmark suite in child processes and writes the report (engine/bench).
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <ostream>
 #include <string>
+#include <thread>
 
 #include "bench/bench.h"
 #include "cli.h"
@@ -56,6 +59,26 @@ void Summarise(const std::vector<bench::RunResult>& results, const std::string& 
       << dir << "/report.md and " << dir << "/report.html\n";
 }
 
+// --dry-run: this shard's runs, and the longest they can take (every run at its hard limit).
+int DryRun(const std::vector<bench::RunSpec>& specs, const bench::BenchOptions& options,
+           std::ostream& out) {
+  const auto slice = bench::ShardSlice(specs, options.shard_index, options.shard_count);
+  double longest = 0.0;
+  for (const bench::RunSpec& s : slice) {
+    const double t = bench::LongestRunS(s, options);
+    longest += t;
+    out << s.Key() << "  (at most " << Duration(t) << ")\n";
+  }
+  const int jobs =
+      options.jobs > 0 ? options.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  out << "Suite '" << options.suite << "': " << specs.size() << " runs; shard "
+      << options.shard_index << "/" << options.shard_count << ": " << slice.size()
+      << " runs, at most " << Duration(longest) << " of run time (every run at its hard limit; "
+      << "a simulation at 4 times its plan's), so at most " << Duration(longest / jobs) << " ("
+      << static_cast<long long>(std::ceil(longest / jobs)) << " s) at --jobs " << jobs << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int Bench(const BenchArgs& args, std::ostream& out, std::ostream& err) {
@@ -63,12 +86,12 @@ int Bench(const BenchArgs& args, std::ostream& out, std::ostream& err) {
     if (args.output.empty())
       return Report({ErrorCode::kInvalidInput, "merge: -o OUT is required"}, err);
     std::vector<std::filesystem::path> dirs(args.merge_dirs.begin(), args.merge_dirs.end());
-    auto merged = bench::MergeShards(dirs, args.output);
+    auto merged = bench::MergeShards(dirs, args.output, args.partial);
     if (!merged) return Report(merged.error(), err);
     Summarise(*merged, args.output, out);
     return 0;
   }
-  if (args.output.empty()) {
+  if (args.output.empty() && !args.dry_run) {
     return Report({ErrorCode::kInvalidInput, "-o DIR: the output folder is required"}, err);
   }
   bench::BenchOptions options;
@@ -80,6 +103,7 @@ int Bench(const BenchArgs& args, std::ostream& out, std::ostream& err) {
   options.hard_limit_s = args.hard_limit_s;
   options.memory_limit_mib = args.memory_limit_mib;
   options.keep_plans = args.keep_plans;
+  options.rerun_loaded = args.rerun_loaded;
   if (!args.shard.empty()) {
     int i = 0, n = 0;
     char extra = 0;
@@ -96,6 +120,7 @@ int Bench(const BenchArgs& args, std::ostream& out, std::ostream& err) {
   options.on_progress = [&](const bench::Progress& p) { PrintProgress(p, err, tty); };
   auto specs = bench::MakeSuite(options);
   if (!specs) return Report(specs.error(), err);
+  if (args.dry_run) return DryRun(*specs, options, out);
   out << "Suite '" << options.suite << "': " << specs->size() << " runs";
   if (options.shard_count > 1)
     out << " (this shard: " << options.shard_index << "/" << options.shard_count << ")";

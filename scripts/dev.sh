@@ -9,6 +9,10 @@
 #                               into build-asan and run the whole test suite there
 #   scripts/dev.sh soak   install, build, and plan every example project 50 times in one process
 #                         (the load tests with WRAP_SOAK_ROUNDS=50; about 25 CPU minutes)
+#   scripts/dev.sh cluster-test install (with Slurm and munge), build `wrap`, and run the Slurm
+#                               test (scripts/slurm/cluster_test.sh: a single-node Slurm of its
+#                               own runs a small suite as a job array, a shard is cancelled and
+#                               resumed, the merge is checked; as root; about 1-2 minutes)
 #   scripts/dev.sh sanitize-ci  the part of `sanitize` that CI runs: no UI, only the suites in
 #                               SANITIZE_CI_SUITES below (core, model, geometry, robot,
 #                               collision with URDF import, the fuzz regression and seed replay)
@@ -27,6 +31,14 @@ BUILD_TYPE=${BUILD_TYPE:-RelWithDebInfo}
 # building the whole engine with ASan does not fit CI's time budget next to the normal build.
 SANITIZE_CI_SUITES=(core_test model_test geometry_test robot_test robot_no_alloc_test
   collision_test fuzz_replay_test)
+
+if [[ "$mode" == cluster-test ]]; then
+  bash scripts/install_deps.sh --cluster
+  BUILD_DIR=${BUILD_DIR:-build}
+  cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE"
+  cmake --build "$BUILD_DIR" --parallel "$(nproc)" --target wrap
+  exec bash scripts/slurm/cluster_test.sh "$BUILD_DIR/app/wrap"
+fi
 
 bash scripts/install_deps.sh
 case "$mode" in
@@ -72,7 +84,7 @@ case "$mode" in
       --gtest_filter='Load.*Planned*'
     ;;
   *)
-    echo "usage: scripts/dev.sh [demo|test|build|soak|sanitize|sanitize-ci]" >&2
+    echo "usage: scripts/dev.sh [demo|test|build|soak|sanitize|sanitize-ci|cluster-test]" >&2
     exit 2
     ;;
 esac

@@ -1,6 +1,11 @@
 #!/usr/bin/env bash
 # Installs exactly the Debian 12 packages Wrap builds and tests with. Idempotent: when every
 # package is already installed it returns at once without touching apt.
+#   scripts/install_deps.sh            what the build and the test suite need
+#   scripts/install_deps.sh --cluster  also Slurm and munge, for `scripts/dev.sh cluster-test`
+#                                      (which starts its own daemons; on a machine with systemd,
+#                                      Debian also enables their services, which the test does
+#                                      not use)
 set -euo pipefail
 
 PACKAGES=(
@@ -26,6 +31,14 @@ PACKAGES=(
   # GUI tests: a virtual X server for the window (xvfb-run needs xauth)
   xvfb xauth
 )
+
+if [[ "${1:-}" == --cluster ]]; then
+  # cluster test: a single-node Slurm (controller, node daemon, sbatch) and its authentication
+  PACKAGES+=(slurm-wlm munge)
+elif [[ $# -gt 0 ]]; then
+  echo "usage: scripts/install_deps.sh [--cluster]" >&2
+  exit 2
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

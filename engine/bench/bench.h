@@ -51,6 +51,21 @@ std::string ToString(Status status);
 /// Inverse of ToString; nullopt for an unknown word.
 std::optional<Status> ParseStatus(const std::string& word);
 
+/// Equal slices of a plan's makespan over which the robots' motion is profiled.
+constexpr int kProfileBins = 20;
+
+/// How busy the robots of a plan with motion are, from its motion segments: a robot is moving
+/// while it takes part in a segment (free path, approach, lift, carry, insert, descend, retreat,
+/// gripper closing or opening). Holding still (bracing a part another robot inserts) is not
+/// moving.
+struct Utilisation {
+  std::map<std::string, double> moving;  ///< Per robot: the share of the makespan it moves [0, 1].
+  /// Robots moving, averaged over each of kProfileBins equal slices of the makespan.
+  std::vector<double> profile;
+  /// Mean over the robots of their moving share [0, 1].
+  double MeanMoving() const;
+};
+
 /// What one run gave: the spec's columns, the classification and the plan's stats.
 struct RunResult {
   RunSpec spec;                    ///< What was run.
@@ -59,6 +74,8 @@ struct RunResult {
   int signal = 0;                  ///< Signal that ended the child, 0 if none.
   double wall_s = 0.0;             ///< Wall time of the plan child [s].
   double peak_rss_mib = 0.0;       ///< Peak resident memory of the plan child (wait4) [MiB].
+  double cpu_s = 0.0;   ///< CPU time (user + system) of its children, plan and sim [s].
+  double sim_wall_s = 0.0;  ///< Wall time of the sim child [s]; 0 when not simulated.
   /// The plan's stats by name (cost, first_cost, t_init_s, t_grasp_s, t_bwd_s, t_lp_s, t_fwd_s,
   /// t_ik_s, t_kf_s, t_mp_s, t_retime_s, t_opt_s, makespan_s); absent where the plan gave none.
   std::map<std::string, double> stats;
@@ -71,8 +88,17 @@ struct RunResult {
   /// insertion_vac (absent where no gripper of the kind took part).
   std::map<std::string, double> sim_util;
   std::string message;  ///< Why it did not solve (planner failure or the log's last line).
+  std::optional<Utilisation> utilisation;  ///< Plans with motion: how busy the robots are.
+  /// Threads ready to run on the machine while the plan ran, averaged over samples every 0.1 s
+  /// (/proc/loadavg's running count, the harness itself not counted); negative: not measured.
+  double load = -1.0;
+  int cores = 0;     ///< Cores of the machine it ran on (online CPUs).
+  std::string host;  ///< Host name of the machine it ran on.
 
   bool solved() const { return status == Status::kSolved; }
+  /// Made while the machine was loaded: on average at least one thread more was ready to run
+  /// than the machine has cores, so the run waited for a core and its times are inflated.
+  bool loaded() const { return cores > 0 && load >= cores + 1.0; }
 };
 
 /// Where a suite stands, for a progress bar.
@@ -102,6 +128,9 @@ struct BenchOptions {
   long long memory_limit_mib = 4096;  ///< Planner memory limit (`--memory-limit`) [MiB]; the
                                       ///< child's address space is limited to 4x this.
   bool keep_plans = false;            ///< Keep every plan JSON (plans/); default: deleted.
+  /// Runs made while the machine was loaded (RunResult::loaded) are run again on resumption
+  /// instead of being kept (their earlier result stays until the new one replaces it).
+  bool rerun_loaded = false;
   /// Called after each finished run (and for runs reused from an earlier, interrupted suite).
   std::function<void(const Progress&)> on_progress;
 };
@@ -110,9 +139,22 @@ struct BenchOptions {
 /// Fails with kInvalidInput for an unknown suite name.
 Result<std::vector<RunSpec>> MakeSuite(const BenchOptions& options);
 
-/// Runs `specs` (this shard's slice: every shard_count-th from shard_index-1) writing each
-/// result to `out/runs/KEY.json` as it finishes (existing ones are kept: a suite resumes), then
-/// results.csv, report.md and report.html. Classification: killed by the hard limit -> timeout;
+/// This shard's slice of a suite: every shard_count-th configuration from shard_index-1, so that
+/// shards get a mix of sizes.
+std::vector<RunSpec> ShardSlice(const std::vector<RunSpec>& specs, int shard_index,
+                                int shard_count);
+
+/// The longest a run can take [s]: the plan child's hard limit (BenchOptions::hard_limit_s, or
+/// the planner's limit plus max(10 s, half of it)), and four times that for `wrap sim` after it.
+double LongestRunS(const RunSpec& spec, const BenchOptions& options);
+
+/// Runs `specs` (this shard's slice, ShardSlice) writing each result to `out/runs/KEY.json` as
+/// it finishes (existing ones are kept: a suite resumes), then results.csv, report.md and
+/// report.html. The folder belongs to one shard of one suite: it is locked while a process uses
+/// it (a second one is refused, naming the first), and its meta.json records the shard's
+/// identity (revision of this build, suite, seeds, limits, shard, the suite's runs and the
+/// projects' contents); resuming it with another identity is refused, naming what differs.
+/// Children run pinned to their own cores where the cores suffice, and die with the harness. Classification: killed by the hard limit -> timeout;
 /// exit 0 -> solved; exit 1 -> unsolved, or timeout when the planner stopped at its limit, or
 /// oom when it stopped at its memory limit; exit 2 -> error; other exits and signals -> crash
 /// (oom when the log shows an allocation failure). Fails with kIo when `out` cannot be written.
@@ -125,9 +167,13 @@ Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& specs,
 Result<std::vector<RunResult>> ReadRunResults(const std::vector<std::filesystem::path>& dirs);
 
 /// `wrap bench merge DIR... -o OUT`: the runs of all shard folders into one results.csv and
-/// report (run files are copied to OUT/runs). Fails with kInvalidInput when a folder has no runs.
+/// report (run files are copied to OUT/runs). Refused (kInvalidInput, every problem named by
+/// folder) when the folders come from different revisions, when folders of one suite differ in
+/// settings, when a shard of a suite is missing, given twice or unfinished (unless `partial`:
+/// then the report's header says what is missing), when a folder is not a shard folder, or when
+/// OUT is one of them.
 Result<std::vector<RunResult>> MergeShards(const std::vector<std::filesystem::path>& dirs,
-                                           const std::filesystem::path& out);
+                                           const std::filesystem::path& out, bool partial = false);
 
 /// Sorts results by project, planner, options, seed.
 void SortResults(std::vector<RunResult>& results);
@@ -144,9 +190,10 @@ std::string ResultsCsv(const std::vector<RunResult>& results);
 struct RunInfo {
   std::string machine;   ///< CPU model, cores, memory.
   std::string load;      ///< Load averages at the start and the end.
-  std::string commit;    ///< `git rev-parse --short HEAD` of the source, or "unknown".
+  std::string commit;    ///< The build's source revision (BuildRevision), or "unknown".
   std::string date;      ///< UTC date and time of the start.
   std::string settings;  ///< Suite, runs, time limit, jobs, shards.
+  std::string caveats;   ///< What the reader must know first (a partial merge), or empty.
 };
 
 /// Writes results.csv, report.md, report.html and the SVG figures into `out` (atomically).

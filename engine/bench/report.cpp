@@ -9,6 +9,7 @@
 
 #include "bench/bench.h"
 #include "bench/paper_numbers.h"
+#include "bench/report_blocks.h"
 #include "bench/svg_plot.h"
 #include "core/file_io.h"
 
@@ -18,33 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The report as blocks, written once as Markdown and once as HTML.
-struct Block {
-  enum Kind { kHeading, kPara, kTable, kFigure } kind = kPara;
-  int level = 2;                               // kHeading
-  std::string text;                            // heading, paragraph, figure caption
-  std::vector<std::string> header;             // kTable
-  std::vector<std::vector<std::string>> rows;  // kTable
-  std::string file;                            // kFigure: SVG file name
-  std::string svg;                             // kFigure: its text
-};
-
 const std::vector<std::string> kPlannerOrder = {"optimistic", "wrap",  "flat",
                                                 "counting",   "exact", "fine"};
-const std::vector<std::string> kComparisonProjects = {
-    "cross", "stool", "chair", "fabrica_beam", "fabrica_plumbers_block", "fabrica_car"};
-
-// The paper's assemblies in its tables' order, then the other projects of `projects` by name.
-std::vector<std::string> ProjectOrder(const std::set<std::string>& projects) {
-  std::vector<std::string> order = kComparisonProjects;
-  for (const std::string& p : projects) {
-    if (std::find(order.begin(), order.end(), p) == order.end()) order.push_back(p);
-  }
-  return order;
-}
-const std::vector<std::string> kPalette = {"#111111", "#0072B2", "#999999", "#009E73",
-                                           "#D55E00", "#CC79A7", "#E69F00", "#56B4E9"};
-
 // The paper's colours of its planners in the convergence figure.
 std::string PlannerColor(const std::string& planner) {
   static const std::map<std::string, std::string> colors = {
@@ -52,70 +28,6 @@ std::string PlannerColor(const std::string& planner) {
       {"counting", "#009E73"}, {"exact", "#D55E00"},      {"fine", "#CC79A7"}};
   const auto it = colors.find(planner);
   return it == colors.end() ? "#E69F00" : it->second;
-}
-
-std::string Fmt(const char* f, double v) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-
-struct Stat {
-  int n = 0;
-  double mean = 0.0, std = 0.0;
-};
-
-Stat Summarise(const std::vector<double>& v) {
-  Stat s;
-  s.n = static_cast<int>(v.size());
-  if (v.empty()) return s;
-  for (double x : v) s.mean += x;
-  s.mean /= s.n;
-  if (s.n > 1) {
-    for (double x : v) s.std += (x - s.mean) * (x - s.mean);
-    s.std = std::sqrt(s.std / (s.n - 1));
-  }
-  return s;
-}
-
-std::string MeanStd(const Stat& s, const char* f = "%.2f") {
-  if (s.n == 0) return "–";
-  if (s.n == 1) return Fmt(f, s.mean) + " (1 run)";
-  return Fmt(f, s.mean) + " ± " + Fmt(f, s.std);
-}
-
-std::vector<double> Values(const std::vector<const RunResult*>& runs, const std::string& stat,
-                           bool solved_only = true) {
-  std::vector<double> v;
-  for (const RunResult* r : runs) {
-    if (solved_only && !r->solved()) continue;
-    if (auto it = r->stats.find(stat); it != r->stats.end()) v.push_back(it->second);
-  }
-  return v;
-}
-
-// "2/3", and the other outcomes in words, e.g. "0/3 (timeout 3)".
-std::string SolvedCell(const std::vector<const RunResult*>& runs) {
-  int solved = 0;
-  std::map<std::string, int> other;
-  for (const RunResult* r : runs) {
-    if (r->solved()) {
-      ++solved;
-    } else {
-      ++other[ToString(r->status)];
-    }
-  }
-  std::string s = std::to_string(solved) + "/" + std::to_string(runs.size());
-  if (!other.empty()) {
-    s += " (";
-    bool first = true;
-    for (const auto& [k, n] : other) {
-      s += (first ? "" : ", ") + k + " " + std::to_string(n);
-      first = false;
-    }
-    s += ")";
-  }
-  return s;
 }
 
 bool IsPlainTaskRun(const RunResult& r) {
@@ -136,16 +48,20 @@ std::string WrenchModel(const RunSpec& s) {
   return "λ = " + Fmt("%g", s.force_scale);
 }
 
-class ReportBuilder {
+class ReportBuilder : public ReportBlocks {
  public:
   explicit ReportBuilder(const std::vector<RunResult>& results) : results_(results) {}
 
   std::vector<Block> Build(const RunInfo& info) {
     Heading(1, "Wrap benchmark report");
+    if (!info.caveats.empty()) Para("**Incomplete: " + info.caveats + ".**");
     Para("Machine: " + info.machine +
          ". Load average (1, 5, 15 min; other work shares the machine): " + info.load + ".");
-    Para("Commit: `" + info.commit + "`. Date: " + info.date + ". Settings: " + info.settings +
-         ".");
+    Para("Commit: `" + info.commit + "`" +
+         (info.commit.find("+changes") != std::string::npos
+              ? " (built with uncommitted changes, which the hash after `+changes.` names)"
+              : "") +
+         ". Date: " + info.date + ". Settings: " + info.settings + ".");
     Para(
         "The paper's numbers (WRAP, Hartmann et al., §V) are means of 10 runs on the authors' "
         "machine with their models of the assemblies; ours are from the runs below, on the "
@@ -158,40 +74,12 @@ class ReportBuilder {
     ScalingParts();
     Convergence();
     Simulation();
+    OwnMeasures(results_, *this);
     Failures();
-    return blocks_;
+    return blocks();
   }
 
  private:
-  void Heading(int level, const std::string& text) {
-    Block b;
-    b.kind = Block::kHeading;
-    b.level = level;
-    b.text = text;
-    blocks_.push_back(b);
-  }
-  void Para(const std::string& text) {
-    Block b;
-    b.kind = Block::kPara;
-    b.text = text;
-    blocks_.push_back(b);
-  }
-  void Table(std::vector<std::string> header, std::vector<std::vector<std::string>> rows) {
-    Block b;
-    b.kind = Block::kTable;
-    b.header = std::move(header);
-    b.rows = std::move(rows);
-    blocks_.push_back(b);
-  }
-  void Figure(const std::string& file, const std::string& caption, const LinePlot& plot) {
-    Block b;
-    b.kind = Block::kFigure;
-    b.file = file;
-    b.text = caption;
-    b.svg = RenderSvg(plot);
-    blocks_.push_back(b);
-  }
-
   template <typename Pred>
   std::vector<const RunResult*> Select(Pred pred) const {
     std::vector<const RunResult*> v;
@@ -204,9 +92,14 @@ class ReportBuilder {
   void Summary() {
     Heading(2, "Runs");
     std::map<std::string, std::map<std::string, int>> by_group;
+    int loaded = 0;
     for (const RunResult& r : results_) {
       ++by_group[r.spec.group][ToString(r.status)];
       ++by_group[r.spec.group]["all"];
+      if (r.loaded()) {
+        ++by_group[r.spec.group]["loaded"];
+        ++loaded;
+      }
     }
     std::vector<std::vector<std::string>> rows;
     for (const auto& [g, c] : by_group) {
@@ -215,12 +108,30 @@ class ReportBuilder {
         return std::to_string(it == c.end() ? 0 : it->second);
       };
       rows.push_back({g, n("all"), n("solved"), n("unsolved"), n("timeout"), n("oom"), n("crash"),
-                      n("error")});
+                      n("error"), n("loaded")});
     }
     Para(
         "Every run is one child process (`wrap plan`, then `wrap sim` where asked) under a "
-        "wall-clock and a memory limit; one row per run is in `results.csv`.");
-    Table({"group", "runs", "solved", "unsolved", "timeout", "oom", "crash", "error"}, rows);
+        "wall-clock and a memory limit, on cores of its own where the machine has enough; one "
+        "row per run is in `results.csv`.");
+    Para(loaded == 0
+             ? std::string("No run was made while the machine was loaded (on average at least one "
+                           "thread more ready to run than the machine has cores).")
+             : std::to_string(loaded) + " of " + std::to_string(results_.size()) +
+                   " runs were made while the machine was loaded (on average at least one thread "
+                   "more ready to run than the machine has cores): their times are inflated. "
+                   "A cell with such runs is marked † and their number; `wrap bench` with the "
+                   "same options, the same -o and `--rerun-loaded` runs them again.");
+    Table({"group", "runs", "solved", "unsolved", "timeout", "oom", "crash", "error", "loaded"},
+          rows);
+    double wall = 0.0, cpu = 0.0;
+    for (const RunResult& r : results_) {
+      wall += r.wall_s + r.sim_wall_s;
+      cpu += r.cpu_s;
+    }
+    Para("The runs took " + Fmt("%.2f", wall / 3600.0) + " h of run time (plan and simulation "
+         "children, wall clock, summed over the runs) and " + Fmt("%.2f", cpu / 3600.0) +
+         " h of CPU time.");
   }
 
   void Comparison() {
@@ -267,12 +178,12 @@ class ReportBuilder {
   }
 
   void Breakdown() {
-    // With motion (t_mp) where the suite planned it; else WRAP's task-only runs.
+    // With motion (t_mp) where the suite planned it (then also simulated: the simulation does
+    // not change the plan's times); else WRAP's task-only runs.
     std::set<std::string> projects;
     for (const RunResult& r : results_) {
       if (r.spec.planner == "wrap" && !r.spec.optimize && r.spec.wrench == "full" &&
-          r.spec.force_scale == 1.0 && r.spec.project.robots == 0 && r.spec.project.steps == 0 &&
-          !r.spec.sim) {
+          r.spec.force_scale == 1.0 && r.spec.project.robots == 0 && r.spec.project.steps == 0) {
         projects.insert(r.spec.project.name);
       }
     }
@@ -291,7 +202,7 @@ class ReportBuilder {
       if (!projects.contains(p)) continue;
       auto runs = Select([&](const RunResult& r) {
         return r.spec.project.name == p && r.spec.planner == "wrap" && r.spec.motion &&
-               !r.spec.optimize && !r.spec.sim && r.spec.wrench == "full" &&
+               !r.spec.optimize && r.spec.wrench == "full" &&
                r.spec.force_scale == 1.0 && r.spec.project.robots == 0 && r.spec.project.steps == 0;
       });
       const bool with_motion = !runs.empty();
@@ -318,7 +229,7 @@ class ReportBuilder {
       if (with_motion) {
         int ok = 0;
         for (const RunResult* r : runs) ok += r->solved() ? 1 : 0;
-        motion = std::to_string(ok) + "/" + std::to_string(runs.size());
+        motion = std::to_string(ok) + "/" + std::to_string(runs.size()) + LoadedMark(runs);
         const Stat m = Summarise(Values(runs, "makespan_s"));
         if (m.n > 0) motion += ", makespan " + Fmt("%.0f", m.mean) + " s";
       }
@@ -536,7 +447,7 @@ class ReportBuilder {
              wrench == "none"      ? "w/o wrench"
              : wrench == "gravity" ? "gravity"
                                    : "full",
-             std::to_string(planned) + "/" + std::to_string(cell.size()),
+             std::to_string(planned) + "/" + std::to_string(cell.size()) + LoadedMark(cell),
              with(Fmt("%.0f", 100.0 * held / n), paper ? paper->success : ""),
              with(Fmt("%.1f", done / n) + "/" + Fmt("%.1f", total / n), paper ? paper->tasks : ""),
              with(fail.empty() ? "--" : fail, paper ? paper->failure : ""),
@@ -565,107 +476,7 @@ class ReportBuilder {
   }
 
   const std::vector<RunResult>& results_;
-  std::vector<Block> blocks_;
 };
-
-// Markdown table cells cannot hold a bar or a line break.
-std::string MdCell(std::string s) {
-  std::string r;
-  for (char c : s) {
-    if (c == '|') {
-      r += "\\|";
-    } else if (c == '\n') {
-      r += ' ';
-    } else {
-      r += c;
-    }
-  }
-  return r;
-}
-
-std::string ToMarkdown(const std::vector<Block>& blocks) {
-  std::ostringstream o;
-  for (const Block& b : blocks) {
-    switch (b.kind) {
-      case Block::kHeading:
-        o << std::string(b.level, '#') << " " << b.text << "\n\n";
-        break;
-      case Block::kPara:
-        o << b.text << "\n\n";
-        break;
-      case Block::kTable: {
-        o << "|";
-        for (const std::string& h : b.header) o << " " << MdCell(h) << " |";
-        o << "\n|";
-        for (size_t i = 0; i < b.header.size(); ++i) o << "---|";
-        o << "\n";
-        for (const auto& row : b.rows) {
-          o << "|";
-          for (const std::string& c : row) o << " " << MdCell(c) << " |";
-          o << "\n";
-        }
-        o << "\n";
-        break;
-      }
-      case Block::kFigure:
-        o << "![" << b.text << "](" << b.file << ")\n\n";
-        break;
-    }
-  }
-  return o.str();
-}
-
-// Paragraph text: escaped, `code` spans as <code>.
-std::string HtmlText(const std::string& s) {
-  std::string r;
-  bool code = false;
-  for (char c : s) {
-    if (c == '`') {
-      r += code ? "</code>" : "<code>";
-      code = !code;
-    } else {
-      r += XmlEscape(std::string(1, c));
-    }
-  }
-  if (code) r += "</code>";
-  return r;
-}
-
-std::string ToHtml(const std::vector<Block>& blocks) {
-  std::ostringstream o;
-  o << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Wrap benchmark report"
-       "</title>\n<style>body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 "
-       "1em}table{border-collapse:collapse;margin:1em 0;font-size:13px}td,th{border:1px solid "
-       "#ccc;padding:3px 6px;text-align:left}th{background:#f3f3f3}code{background:#f5f5f5}"
-       "figure{margin:1em 0}</style></head><body>\n";
-  for (const Block& b : blocks) {
-    switch (b.kind) {
-      case Block::kHeading:
-        o << "<h" << b.level << ">" << HtmlText(b.text) << "</h" << b.level << ">\n";
-        break;
-      case Block::kPara:
-        o << "<p>" << HtmlText(b.text) << "</p>\n";
-        break;
-      case Block::kTable:
-        o << "<table><tr>";
-        for (const std::string& h : b.header) o << "<th>" << HtmlText(h) << "</th>";
-        o << "</tr>\n";
-        for (const auto& row : b.rows) {
-          o << "<tr>";
-          for (const std::string& c : row) o << "<td>" << HtmlText(c) << "</td>";
-          o << "</tr>\n";
-        }
-        o << "</table>\n";
-        break;
-      case Block::kFigure:
-        o << "<figure>" << b.svg << "<figcaption>" << HtmlText(b.text)
-          << "</figcaption></figure>\n";
-        break;
-    }
-  }
-  o << "</body></html>\n";
-  return o.str();
-}
 
 }  // namespace
 

@@ -63,6 +63,8 @@ std::string RunResultToJson(const RunResult& r) {
   j["signal"] = r.signal;
   j["wall_s"] = r.wall_s;
   j["peak_rss_mib"] = r.peak_rss_mib;
+  j["cpu_s"] = r.cpu_s;
+  j["sim_wall_s"] = r.sim_wall_s;
   Json stats = Json::object();
   for (const auto& [k, v] : r.stats) stats[k] = v;
   j["stats"] = stats;
@@ -78,6 +80,14 @@ std::string RunResultToJson(const RunResult& r) {
                 {"failure", r.sim_failure},
                 {"peak_utilisation_percent", util}};
   }
+  if (r.utilisation) {
+    Json moving = Json::object();
+    for (const auto& [k, v] : r.utilisation->moving) moving[k] = v;
+    j["utilisation"] = {{"moving", moving}, {"profile", r.utilisation->profile}};
+  }
+  j["load"] = r.load;
+  j["cores"] = r.cores;
+  j["host"] = r.host;
   j["message"] = r.message;
   return j.dump(2) + "\n";
 }
@@ -113,6 +123,8 @@ Result<RunResult> RunResultFromJson(const std::string& text, const std::string& 
     r.signal = j.value("signal", 0);
     r.wall_s = j.value("wall_s", 0.0);
     r.peak_rss_mib = j.value("peak_rss_mib", 0.0);
+    r.cpu_s = j.value("cpu_s", 0.0);
+    r.sim_wall_s = j.value("sim_wall_s", 0.0);
     for (const auto& [k, v] : j.at("stats").items()) r.stats[k] = v.get<double>();
     for (const Json& h : j.at("cost_history")) {
       r.cost_history.emplace_back(h.at(0).get<double>(), h.at(1).get<double>());
@@ -130,6 +142,17 @@ Result<RunResult> RunResultFromJson(const std::string& text, const std::string& 
     } else {
       r.spec.sim = sim.get<bool>();
     }
+    if (j.contains("utilisation")) {
+      Utilisation u;
+      for (const auto& [k, v] : j.at("utilisation").at("moving").items()) {
+        u.moving[k] = v.get<double>();
+      }
+      u.profile = j.at("utilisation").at("profile").get<std::vector<double>>();
+      r.utilisation = u;
+    }
+    r.load = j.value("load", -1.0);
+    r.cores = j.value("cores", 0);
+    r.host = j.value("host", "");
     r.message = j.value("message", "");
   } catch (const Json::exception& e) {
     return Fail(ErrorCode::kInvalidInput, source + ": " + e.what());
@@ -141,9 +164,9 @@ std::string ResultsCsv(const std::vector<RunResult>& results) {
   std::ostringstream s;
   s << "project,planner,options,seed,status,solved";
   for (const std::string& c : kStatColumns) s << "," << c;
-  s << ",peak_rss_mib,wall_s,exit_code,signal,sim_success,sim_tasks,sim_failure";
+  s << ",peak_rss_mib,wall_s,cpu_s,sim_wall_s,exit_code,signal,sim_success,sim_tasks,sim_failure";
   for (const std::string& c : kUtilColumns) s << ",sim_util_" << c;
-  s << ",cost_history,group,message\n";
+  s << ",robots_moving_percent,moving_profile,load,cores,loaded,host,cost_history,group,message\n";
   for (const RunResult& r : results) {
     s << CsvField(r.spec.project.name) << "," << r.spec.planner << "," << r.spec.Options() << ","
       << r.spec.seed << "," << ToString(r.status) << "," << (r.solved() ? 1 : 0);
@@ -151,8 +174,8 @@ std::string ResultsCsv(const std::vector<RunResult>& results) {
       s << ",";
       if (auto it = r.stats.find(c); it != r.stats.end()) s << Num(it->second);
     }
-    s << "," << Num(r.peak_rss_mib) << "," << Num(r.wall_s) << "," << r.exit_code << "," << r.signal
-      << ",";
+    s << "," << Num(r.peak_rss_mib) << "," << Num(r.wall_s) << "," << Num(r.cpu_s) << ","
+      << Num(r.sim_wall_s) << "," << r.exit_code << "," << r.signal << ",";
     if (r.sim_success) s << (*r.sim_success ? 1 : 0);
     s << ",";
     if (r.sim_success) s << r.sim_tasks_completed << "/" << r.sim_tasks_total;
@@ -161,6 +184,18 @@ std::string ResultsCsv(const std::vector<RunResult>& results) {
       s << ",";
       if (auto it = r.sim_util.find(c); it != r.sim_util.end()) s << Num(it->second);
     }
+    s << ",";
+    if (r.utilisation) {
+      s << Num(100.0 * r.utilisation->MeanMoving()) << ",";
+      std::string profile;
+      for (double v : r.utilisation->profile) profile += (profile.empty() ? "" : " ") + Num(v);
+      s << profile;
+    } else {
+      s << ",";
+    }
+    s << ",";
+    if (r.load >= 0.0) s << Num(r.load);
+    s << "," << r.cores << "," << (r.loaded() ? 1 : 0) << "," << CsvField(r.host);
     std::string hist;
     for (const auto& [t, c] : r.cost_history) {
       hist += (hist.empty() ? "" : " ") + Num(t) + ":" + Num(c);

@@ -1,24 +1,26 @@
 // Runs a suite: every run a child `wrap plan` (and `wrap sim`) process under a wall-clock and an
-// address-space limit, up to `jobs` at once; timeouts, out-of-memory and crashes become results.
+// address-space limit, up to `jobs` at once on cores of their own; timeouts, out-of-memory and
+// crashes become results. The folder is one shard's: locked, its identity in meta.json.
 #include <fcntl.h>
+#include <sched.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
 #include <thread>
 
 #include "bench/bench.h"
+#include "bench/child_output.h"
+#include "bench/shard.h"
 #include "core/file_io.h"
 
 namespace wrap::bench {
@@ -26,38 +28,15 @@ namespace wrap::bench {
 namespace {
 
 namespace fs = std::filesystem;
-using Json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 volatile std::sig_atomic_t g_interrupted = 0;
 void OnInterrupt(int) { g_interrupted = 1; }
 
-const std::vector<std::string> kStats = {
-    "cost",   "first_cost", "t_init_s", "t_grasp_s",  "t_bwd_s", "t_lp_s",    "t_fwd_s",
-    "t_ik_s", "t_kf_s",     "t_mp_s",   "t_retime_s", "t_opt_s", "makespan_s"};
-
 std::string Num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
-}
-
-// The last non-empty line of a log file (at most 300 characters).
-std::string LastLine(const fs::path& log) {
-  std::ifstream in(log);
-  std::string line, last;
-  while (std::getline(in, line)) {
-    if (!line.empty()) last = line;
-  }
-  if (last.size() > 300) last = last.substr(0, 300) + "...";
-  return last;
-}
-
-bool LogMentions(const fs::path& log, const std::string& what) {
-  std::ifstream in(log);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str().find(what) != std::string::npos;
 }
 
 // Messages name files by their place in the output folder, not by this machine's paths.
@@ -70,22 +49,42 @@ std::string WithinOutput(std::string message, const fs::path& out) {
   return message;
 }
 
-// One child process: the command, its limits and where it writes.
-struct Child {
-  pid_t pid = -1;
-  Clock::time_point start;
-  Clock::time_point deadline;
-  bool term_sent = false;
-  bool kill_sent = false;
-};
+double CpuSeconds(const rusage& ru) {
+  return static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+// Threads ready to run on the machine now, the reader itself not counted (/proc/loadavg's
+// "running/total" field); negative when unknown.
+double RunnableThreads() {
+  std::ifstream in("/proc/loadavg");
+  double a, b, c;
+  int running = 0;
+  char slash = 0;
+  if (!(in >> a >> b >> c >> running >> slash) || slash != '/') return -1.0;
+  return std::max(0, running - 1);
+}
 
 // Starts `argv` in its own process group with stdout and stderr appended to `log`, its address
-// space limited to `as_mib`. Returns the pid, or -1 (errno) when fork failed.
-pid_t Spawn(const std::vector<std::string>& argv, const fs::path& log, long long as_mib) {
+// space limited to `as_mib`, on `cpus` (all when empty); it dies with this process. Returns the
+// pid, or -1 (errno) when fork failed.
+pid_t Spawn(const std::vector<std::string>& argv, const fs::path& log, long long as_mib,
+            const std::vector<int>& cpus) {
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid != 0) return pid;
   // Child: only async-signal-safe calls until exec.
   setpgid(0, 0);
+  // A harness killed outright (SIGKILL, a node lost) takes its children along, so a resumed
+  // shard never meets an orphan still writing the same files.
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() != parent) _exit(127);
+  if (!cpus.empty()) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    for (int c : cpus) CPU_SET(c, &set);
+    sched_setaffinity(0, sizeof set, &set);
+  }
   const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
   if (fd >= 0) {
     dup2(fd, 1);
@@ -116,6 +115,15 @@ pid_t Spawn(const std::vector<std::string>& argv, const fs::path& log, long long
   _exit(127);
 }
 
+// One child process.
+struct Child {
+  pid_t pid = -1;
+  Clock::time_point start;
+  Clock::time_point deadline;
+  bool term_sent = false;
+  bool kill_sent = false;
+};
+
 // A job: one run, in the plan phase and then, if asked, the sim phase.
 struct Job {
   RunSpec spec;
@@ -124,7 +132,43 @@ struct Job {
   RunResult result;
   Child child;
   bool sim_phase = false;
+  int slot = -1;            // which of the `jobs` core sets it runs on
+  double load_sum = 0.0;    // runnable threads summed over the plan phase's samples
+  int load_samples = 0;
 };
+
+std::string Describe(const RunResult& r) {
+  std::string s = r.spec.project.name + " " + r.spec.planner + " " + r.spec.Options() + " seed " +
+                  std::to_string(r.spec.seed) + ": " + ToString(r.status);
+  if (r.solved()) {
+    if (auto it = r.stats.find("cost"); it != r.stats.end()) s += ", cost " + Num(it->second);
+    if (auto it = r.stats.find("t_init_s"); it != r.stats.end()) {
+      s += ", t_init " + Num(it->second) + " s";
+    }
+  }
+  if (r.sim_success) s += std::string(", sim ") + (*r.sim_success ? "holds" : r.sim_failure);
+  if (r.loaded()) s += " (machine loaded: " + Num(std::round(r.load * 10) / 10) + " threads ready)";
+  return s;
+}
+
+// The cores of each of `jobs` slots: this process's allowed CPUs split evenly, so that runs do
+// not compete for cores; no pinning (empty sets) when there are fewer CPUs than jobs.
+std::vector<std::vector<int>> CoreSlots(int jobs) {
+  std::vector<std::vector<int>> slots(jobs);
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof set, &set) != 0) return slots;
+  std::vector<int> cpus;
+  for (int c = 0; c < CPU_SETSIZE; ++c) {
+    if (CPU_ISSET(c, &set)) cpus.push_back(c);
+  }
+  const int n = static_cast<int>(cpus.size());
+  if (n < jobs) return slots;
+  for (int s = 0; s < jobs; ++s) {
+    for (int i = s * n / jobs; i < (s + 1) * n / jobs; ++i) slots[s].push_back(cpus[i]);
+  }
+  return slots;
+}
 
 fs::path ProjectFile(const RunSpec& spec, const BenchOptions& options, const fs::path& out) {
   if (spec.project.robots == 0 && spec.project.steps == 0) {
@@ -133,10 +177,163 @@ fs::path ProjectFile(const RunSpec& spec, const BenchOptions& options, const fs:
   return out / "projects" / (spec.project.name + ".json");
 }
 
-std::vector<std::string> PlanArgv(const Job& job, const fs::path& exe, const fs::path& out,
-                                  const BenchOptions& options) {
+// The suite run of one shard in one folder.
+class SuiteRunner {
+ public:
+  SuiteRunner(const BenchOptions& options, fs::path out, fs::path exe)
+      : options_(options), out_(std::move(out)), exe_(std::move(exe)) {}
+
+  Result<void> Prepare(const std::vector<RunSpec>& all_specs);
+  Result<std::vector<RunResult>> Run();
+
+ private:
+  std::vector<std::string> PlanArgv(const Job& job) const;
+  bool Start(Job& job);
+  bool Finish(Job& job, int wstatus, const rusage& ru);
+  void ClassifyPlan(Job& job, int wstatus, const rusage& ru, double wall);
+  void Record(Job& job);
+  void Report(const RunResult& r, bool fresh);
+  Result<void> Close(bool finished);
+  double HardLimit(const RunSpec& s) const;
+
+  BenchOptions options_;
+  fs::path out_;
+  fs::path exe_;
+  std::optional<FolderLock> lock_;
+  FolderMeta meta_;
+  std::vector<Job> jobs_;
+  std::vector<size_t> queue_;
+  std::vector<std::vector<int>> slots_;
+  std::vector<bool> slot_used_;
+  std::vector<RunResult> results_;
+  Progress progress_;
+  Clock::time_point t0_ = Clock::now();
+  int fresh_done_ = 0;
+  Result<void> write_error_;
+};
+
+// The plan child's wall-clock limit [s].
+double PlanHardLimitS(const RunSpec& s, const BenchOptions& options) {
+  if (options.hard_limit_s > 0.0) return options.hard_limit_s;
+  return s.time_limit_s + std::max(10.0, 0.5 * s.time_limit_s);
+}
+
+double SuiteRunner::HardLimit(const RunSpec& s) const { return PlanHardLimitS(s, options_); }
+
+Result<void> SuiteRunner::Prepare(const std::vector<RunSpec>& all_specs) {
+  std::error_code ec;
+  fs::create_directories(out_, ec);
+  if (ec) return Fail(ErrorCode::kIo, out_.string() + ": cannot create folder: " + ec.message());
+  auto lock = FolderLock::Acquire(out_);
+  if (!lock) return std::unexpected(lock.error());
+  lock_.emplace(std::move(*lock));
+
+  // The folder is this shard's: a new one, or one that an earlier call with the same identity
+  // left (then it resumes).
+  const ShardId id = MakeShardId(all_specs, options_);
+  if (fs::exists(out_ / "meta.json")) {
+    auto old = ReadFolderMeta(out_);
+    if (!old) return std::unexpected(old.error());
+    if (old->kind != "shard") {
+      return Fail(ErrorCode::kInvalidInput, out_.string() + ": holds a merged report, not a "
+                                                            "shard: give `wrap bench` a new -o");
+    }
+    const auto d = Differences(id, old->shards.front().id, true);
+    if (!d.empty()) {
+      std::string why;
+      for (const std::string& s : d) why += (why.empty() ? "" : "; ") + s;
+      return Fail(ErrorCode::kInvalidInput,
+                  out_.string() + ": holds " + old->shards.front().id.Describe() +
+                      " run otherwise than this call (" + why +
+                      ", 'here' being this call): resume it with its own settings, or give "
+                      "another -o");
+    }
+    meta_ = *old;
+  } else if (fs::exists(out_ / "runs") && !fs::is_empty(out_ / "runs", ec)) {
+    return Fail(ErrorCode::kInvalidInput,
+                out_.string() + ": has runs but no meta.json (an older `wrap bench`'s folder?): "
+                                "give another -o");
+  } else {
+    meta_.shards = {ShardRecord{id, {}, 0}};
+  }
+  meta_.kind = "shard";
+  meta_.shards.front().sessions.push_back(StartSession(options_.jobs));
+
+  for (const char* sub : {"runs", "plans", "logs", "sims", "projects"}) {
+    fs::create_directories(out_ / sub, ec);
+    if (ec) {
+      return Fail(ErrorCode::kIo, (out_ / sub).string() + ": cannot create folder: " + ec.message());
+    }
+  }
+  // Temporary files of a write that a killed process left behind (never a result).
+  for (const auto& e : fs::directory_iterator(out_ / "runs", ec)) {
+    if (e.path().filename().string().starts_with(".")) fs::remove(e.path(), ec);
+  }
+  for (const RunSpec& spec : ShardSlice(all_specs, options_.shard_index, options_.shard_count)) {
+    Job job;
+    job.spec = spec;
+    job.key = spec.Key();
+    job.project_file = ProjectFile(spec, options_, out_);
+    job.result.spec = spec;
+    jobs_.push_back(std::move(job));
+  }
+  // Projects first: the examples must exist, the derived ones are written here.
+  std::set<std::string> written;
+  for (const Job& job : jobs_) {
+    const ProjectSpec& p = job.spec.project;
+    if (p.robots == 0 && p.steps == 0) {
+      if (!fs::exists(job.project_file)) {
+        return Fail(ErrorCode::kInvalidInput,
+                    job.project_file.string() +
+                        ": project file not found (set --projects to the folder of the example "
+                        "projects)");
+      }
+      continue;
+    }
+    if (!written.insert(p.name).second) continue;
+    const fs::path base = options_.projects_dir / (p.base + ".json");
+    if (auto w = WriteDerivedProject(p, base, job.project_file); !w) {
+      return std::unexpected(w.error());
+    }
+  }
+  if (auto w = WriteFolderMeta(out_, meta_); !w) return w;
+
+  progress_.total = static_cast<int>(jobs_.size());
+  slots_ = CoreSlots(options_.jobs);
+  slot_used_.assign(slots_.size(), false);
+  // Runs finished by an earlier, interrupted call are kept (those made on a loaded machine run
+  // again when asked to).
+  for (size_t i = 0; i < jobs_.size(); ++i) {
+    const fs::path file = out_ / "runs" / (jobs_[i].key + ".json");
+    if (fs::exists(file)) {
+      auto text = ReadFile(file);
+      auto r = text ? RunResultFromJson(*text, file.string()) : Result<RunResult>();
+      if (text && r && !(options_.rerun_loaded && r->loaded())) {
+        results_.push_back(*r);
+        Report(*r, false);
+        continue;
+      }
+    }
+    queue_.push_back(i);
+  }
+  std::reverse(queue_.begin(), queue_.end());
+  return {};
+}
+
+void SuiteRunner::Report(const RunResult& r, bool fresh) {
+  ++progress_.done;
+  if (fresh) ++fresh_done_;
+  ++progress_.counts[ToString(r.status)];
+  progress_.elapsed_s = std::chrono::duration<double>(Clock::now() - t0_).count();
+  const int left = progress_.total - progress_.done;
+  progress_.eta_s = fresh_done_ > 0 ? progress_.elapsed_s / fresh_done_ * left : -1.0;
+  progress_.last = (fresh ? "" : "(reused) ") + Describe(r);
+  if (options_.on_progress) options_.on_progress(progress_);
+}
+
+std::vector<std::string> SuiteRunner::PlanArgv(const Job& job) const {
   const RunSpec& s = job.spec;
-  std::vector<std::string> a = {exe.string(),
+  std::vector<std::string> a = {exe_.string(),
                                 "plan",
                                 job.project_file.string(),
                                 "--planner",
@@ -150,421 +347,239 @@ std::vector<std::string> PlanArgv(const Job& job, const fs::path& exe, const fs:
                                 "--force-scale",
                                 Num(s.force_scale),
                                 "--memory-limit",
-                                std::to_string(options.memory_limit_mib),
+                                std::to_string(options_.memory_limit_mib),
                                 "-o",
-                                (out / "plans" / (job.key + ".json")).string()};
+                                (out_ / "plans" / (job.key + ".json")).string()};
   if (s.optimize) a.push_back("--optimize");
   if (!s.motion) a.push_back("--task-only");
   return a;
 }
 
-// Fills the result from the plan file the child wrote (if any).
-void ReadPlanStats(RunResult& r, const fs::path& plan_file, std::string& failure,
-                   bool& out_of_memory) {
-  auto text = ReadFile(plan_file);
-  if (!text) return;
-  const Json j = Json::parse(*text, nullptr, false);
-  if (j.is_discarded() || !j.contains("stats") || !j["stats"].is_object()) return;
-  const Json& st = j["stats"];
-  const bool solved = st.value("solved", false);
-  for (const std::string& k : kStats) {
-    if (!st.contains(k) || !st[k].is_number()) continue;
-    // Cost and its history mean nothing without a plan; the times do.
-    if (!solved && (k == "cost" || k == "first_cost" || k == "makespan_s")) continue;
-    // Motion times where motion was tried (also when it failed), none for a task-only plan.
-    const bool motion_stat = k == "t_kf_s" || k == "t_mp_s" || k == "t_retime_s";
-    if (motion_stat && !st.value("motion", false) && st[k].get<double>() == 0.0) continue;
-    if (k == "makespan_s" && !st.value("motion", false)) continue;
-    r.stats[k] = st[k].get<double>();
-  }
-  if (solved && st.contains("cost_history") && st["cost_history"].is_array()) {
-    for (const Json& h : st["cost_history"]) {
-      if (h.is_array() && h.size() == 2) {
-        r.cost_history.emplace_back(h[0].get<double>(), h[1].get<double>());
-      }
-    }
-  }
-  failure = st.value("failure", "");
-  out_of_memory = st.value("out_of_memory", false);
-}
-
-void ReadSimReport(RunResult& r, const fs::path& file) {
-  auto text = ReadFile(file);
-  const Json j = text ? Json::parse(*text, nullptr, false) : Json();
-  if (!text || j.is_discarded() || !j.is_object() || !j.contains("success")) {
-    r.sim_success = false;
-    r.sim_failure = "no sim report";
-    return;
-  }
-  r.sim_success = j.value("success", false);
-  r.sim_tasks_completed = j.value("tasks_completed", 0);
-  r.sim_tasks_total = j.value("tasks_total", 0);
-  if (j.contains("failure") && j["failure"].is_object()) {
-    r.sim_failure = j["failure"].value("reason", "failed");
-  }
-  if (j.contains("peak_utilisation_percent")) {
-    const Json& u = j["peak_utilisation_percent"];
-    const auto get = [&](const char* phase, const char* kind, const char* name) {
-      if (u.contains(phase) && u[phase].contains(kind) && u[phase][kind].is_number()) {
-        r.sim_util[name] = u[phase][kind].get<double>();
-      }
-    };
-    get("transport", "two_finger", "transport_2f");
-    get("transport", "vacuum", "transport_vac");
-    get("insertion", "two_finger", "insertion_2f");
-    get("insertion", "vacuum", "insertion_vac");
-  }
-}
-
-std::string Describe(const RunResult& r) {
-  std::string s = r.spec.project.name + " " + r.spec.planner + " " + r.spec.Options() + " seed " +
-                  std::to_string(r.spec.seed) + ": " + ToString(r.status);
-  if (r.solved()) {
-    if (auto it = r.stats.find("cost"); it != r.stats.end()) s += ", cost " + Num(it->second);
-    if (auto it = r.stats.find("t_init_s"); it != r.stats.end()) {
-      s += ", t_init " + Num(it->second) + " s";
-    }
-  }
-  if (r.sim_success) s += std::string(", sim ") + (*r.sim_success ? "holds" : r.sim_failure);
-  return s;
-}
-
-std::string CommandOutput(const std::string& command) {
-  std::string out;
-  if (FILE* f = popen(command.c_str(), "r")) {
-    char buf[256];
-    while (std::fgets(buf, sizeof buf, f)) out += buf;
-    pclose(f);
-  }
-  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
-  return out;
-}
-
-std::string LoadAverage() {
-  std::ifstream in("/proc/loadavg");
-  double a = 0, b = 0, c = 0;
-  in >> a >> b >> c;
-  return Num(a) + " " + Num(b) + " " + Num(c);
-}
-
-// Machine, commit and date of this run, and the settings of the suite.
-RunInfo CollectInfo(const BenchOptions& options, size_t runs) {
-  RunInfo info;
-  std::ifstream cpu("/proc/cpuinfo");
-  std::string line, model = "unknown CPU";
-  while (std::getline(cpu, line)) {
-    if (line.starts_with("model name")) {
-      model = line.substr(line.find(':') + 2);
-      break;
-    }
-  }
-  std::ifstream mem("/proc/meminfo");
-  std::string key;
-  long long kib = 0;
-  mem >> key >> kib;
-  info.machine = model + ", " + std::to_string(std::thread::hardware_concurrency()) + " cores, " +
-                 Num(std::round(kib / 1048576.0)) + " GiB";
-  const std::string host_os = CommandOutput("uname -sr 2>/dev/null");
-  if (!host_os.empty()) info.machine += ", " + host_os;
-  info.load = "at the start " + LoadAverage();
-  const fs::path src = fs::absolute(options.projects_dir).parent_path();
-  const std::string q = "'" + src.string() + "'";
-  info.commit = CommandOutput("git -C " + q + " rev-parse --short HEAD 2>/dev/null");
-  if (info.commit.empty()) {
-    info.commit = "unknown";
-  } else if (!CommandOutput("git -C " + q +
-                            " status --porcelain --untracked-files=no -- engine app 2>/dev/null")
-                  .empty()) {
-    info.commit += " (with local changes)";
-  }
-  char date[64];
-  const std::time_t now = std::time(nullptr);
-  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
-  info.date = date;
-  info.settings = "suite " + options.suite + ", " + std::to_string(options.runs) +
-                  " seed(s) per configuration, " + std::to_string(runs) + " runs, time limit " +
-                  (options.time_limit_s ? Num(*options.time_limit_s) + " s"
-                                        : std::string("the suite's default")) +
-                  ", " + std::to_string(options.jobs) + " job(s) at once, shard " +
-                  std::to_string(options.shard_index) + "/" + std::to_string(options.shard_count) +
-                  ", planner memory limit " + std::to_string(options.memory_limit_mib) + " MiB";
-  return info;
-}
-
-Json InfoToJson(const RunInfo& i) {
-  return {{"machine", i.machine},
-          {"load", i.load},
-          {"commit", i.commit},
-          {"date", i.date},
-          {"settings", i.settings}};
-}
-
-RunInfo InfoFromJson(const Json& j) {
-  RunInfo i;
-  i.machine = j.value("machine", "");
-  i.load = j.value("load", "");
-  i.commit = j.value("commit", "");
-  i.date = j.value("date", "");
-  i.settings = j.value("settings", "");
-  return i;
-}
-
-}  // namespace
-
-Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
-                                        const BenchOptions& given, const fs::path& out) {
-  BenchOptions options = given;
-  if (options.jobs <= 0) options.jobs = std::max(1u, std::thread::hardware_concurrency());
-  if (options.shard_count < 1 || options.shard_index < 1 ||
-      options.shard_index > options.shard_count) {
-    return Fail(ErrorCode::kInvalidInput, "--shard: expected I/N with 1 <= I <= N");
-  }
-  fs::path exe = options.wrap_exe;
-  if (exe.empty()) {
-    std::error_code ec;
-    exe = fs::read_symlink("/proc/self/exe", ec);
-    if (ec) return Fail(ErrorCode::kInternal, "bench: cannot find this executable");
-  }
-  exe = fs::absolute(exe);
+bool SuiteRunner::Start(Job& job) {
   std::error_code ec;
-  for (const char* sub : {"runs", "plans", "logs", "sims", "projects"}) {
-    fs::create_directories(out / sub, ec);
-    if (ec) {
-      return Fail(ErrorCode::kIo, (out / sub).string() + ": cannot create folder: " + ec.message());
-    }
+  const fs::path log = out_ / "logs" / (job.key + ".log");
+  std::vector<std::string> argv;
+  if (!job.sim_phase) {
+    fs::remove(log, ec);
+    argv = PlanArgv(job);
+  } else {
+    argv = {exe_.string(),
+            "sim",
+            job.project_file.string(),
+            "--plan",
+            (out_ / "plans" / (job.key + ".json")).string(),
+            "-o",
+            (out_ / "sims" / (job.key + ".json")).string()};
   }
-
-  // This shard's slice: every shard_count-th configuration, so shards get a mix of sizes.
-  std::vector<Job> jobs;
-  for (size_t i = 0; i < all_specs.size(); ++i) {
-    if (static_cast<int>(i % options.shard_count) != options.shard_index - 1) continue;
-    Job job;
-    job.spec = all_specs[i];
-    job.key = job.spec.Key();
-    job.project_file = ProjectFile(job.spec, options, out);
-    job.result.spec = job.spec;
-    jobs.push_back(std::move(job));
+  {
+    std::ofstream l(log, std::ios::app);
+    for (const std::string& a : argv) l << a << " ";
+    l << "\n";
   }
-  // Projects first: the examples must exist, the derived ones are written here.
-  std::set<std::string> written;
-  for (const Job& job : jobs) {
-    const ProjectSpec& p = job.spec.project;
-    if (p.robots == 0 && p.steps == 0) {
-      if (!fs::exists(job.project_file)) {
-        return Fail(ErrorCode::kInvalidInput,
-                    job.project_file.string() +
-                        ": project file not found (set --projects to the folder of the example "
-                        "projects)");
+  if (job.slot < 0) {
+    for (size_t s = 0; s < slot_used_.size(); ++s) {
+      if (!slot_used_[s]) {
+        job.slot = static_cast<int>(s);
+        slot_used_[s] = true;
+        break;
       }
-      continue;
-    }
-    if (!written.insert(p.name).second) continue;
-    const fs::path base = options.projects_dir / (p.base + ".json");
-    if (auto w = WriteDerivedProject(p, base, job.project_file); !w) {
-      return std::unexpected(w.error());
     }
   }
+  job.child = Child{};
+  job.child.start = Clock::now();
+  // Simulating a plan takes longer than planning it on a slow machine (MuJoCo steps through
+  // the whole makespan): the sim child gets four times the plan's limit.
+  const double limit_s = HardLimit(job.spec) * (job.sim_phase ? 4.0 : 1.0);
+  job.child.deadline =
+      job.child.start + std::chrono::milliseconds(static_cast<long long>(1000 * limit_s));
+  static const std::vector<int> kAnyCpu;
+  job.child.pid = Spawn(argv, log, 4 * options_.memory_limit_mib,
+                        job.slot >= 0 ? slots_[job.slot] : kAnyCpu);
+  return job.child.pid > 0;
+}
 
-  RunInfo info = CollectInfo(options, jobs.size());
-  if (auto w = WriteFileAtomic(out / "meta.json", InfoToJson(info).dump(2) + "\n"); !w) {
-    return std::unexpected(w.error());
+void SuiteRunner::ClassifyPlan(Job& job, int wstatus, const rusage& ru, double wall) {
+  RunResult& r = job.result;
+  const fs::path log = out_ / "logs" / (job.key + ".log");
+  r.wall_s = wall;
+  r.peak_rss_mib = static_cast<double>(ru.ru_maxrss) / 1024.0;
+  r.cpu_s = CpuSeconds(ru);
+  const PlanOutcome plan = ReadPlanFile(r, out_ / "plans" / (job.key + ".json"));
+  if (job.child.term_sent) {
+    r.status = Status::kTimeout;
+    r.signal = WIFSIGNALED(wstatus) ? WTERMSIG(wstatus) : 0;
+    r.exit_code = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
+    r.message = "killed by the harness after " + Num(std::round(wall * 10) / 10) +
+                " s (hard limit " + Num(HardLimit(job.spec)) + " s)";
+  } else if (WIFSIGNALED(wstatus)) {
+    r.signal = WTERMSIG(wstatus);
+    r.exit_code = -1;
+    r.status = r.signal == SIGKILL ? Status::kOutOfMemory : Status::kCrash;
+    r.message = std::string("signal ") + std::to_string(r.signal) + " (" + strsignal(r.signal) +
+                ")" + (r.signal == SIGKILL ? ", likely the OOM killer" : "");
+  } else {
+    r.exit_code = WEXITSTATUS(wstatus);
+    switch (r.exit_code) {
+      case 0:
+        r.status = Status::kSolved;
+        break;
+      case 1:
+        r.status = plan.out_of_memory ? Status::kOutOfMemory
+                   : plan.failure.starts_with("time limit") ||
+                           LogMentions(log, "time limit ran out")
+                       ? Status::kTimeout
+                       : Status::kUnsolved;
+        r.message = plan.failure.empty() ? LastLine(log) : plan.failure;
+        break;
+      case 2:
+        r.status = Status::kError;
+        r.message = LastLine(log);
+        break;
+      default:
+        r.status = LogMentions(log, "bad_alloc") || LogMentions(log, "out of memory")
+                       ? Status::kOutOfMemory
+                       : Status::kCrash;
+        r.message = "exit " + std::to_string(r.exit_code) + ": " + LastLine(log);
+    }
   }
+  r.message = WithinOutput(r.message, out_);
+  if (r.message.size() > 400) r.message = r.message.substr(0, 400) + "...";
+  const Session& session = meta_.shards.front().sessions.back();
+  r.cores = session.cores;
+  r.host = session.host;
+  const double now = RunnableThreads();
+  r.load = job.load_samples > 0 ? job.load_sum / job.load_samples : now;
+}
 
+// Classifies a finished child; returns true when the job is complete.
+bool SuiteRunner::Finish(Job& job, int wstatus, const rusage& ru) {
+  RunResult& r = job.result;
+  const double wall = std::chrono::duration<double>(Clock::now() - job.child.start).count();
+  if (job.sim_phase) {
+    const fs::path log = out_ / "logs" / (job.key + ".log");
+    r.sim_wall_s = wall;
+    r.cpu_s += CpuSeconds(ru);
+    if (job.child.term_sent) {
+      r.sim_success = false;
+      r.sim_failure = "sim killed at the hard limit";
+    } else if (WIFSIGNALED(wstatus) || (WIFEXITED(wstatus) && WEXITSTATUS(wstatus) >= 2)) {
+      r.sim_success = false;
+      r.sim_failure = "sim error: " + WithinOutput(LastLine(log), out_);
+    } else {
+      ReadSimReport(r, out_ / "sims" / (job.key + ".json"));
+    }
+    return true;
+  }
+  ClassifyPlan(job, wstatus, ru, wall);
+  if (r.solved() && job.spec.sim && job.spec.motion) {
+    job.sim_phase = true;
+    return false;
+  }
+  if (job.spec.sim && !r.solved()) {
+    r.sim_success = false;
+    r.sim_failure = "no plan";
+  }
+  return true;
+}
+
+// A complete job: its result file (atomic), then the progress.
+void SuiteRunner::Record(Job& job) {
+  std::error_code ec;
+  if (job.slot >= 0) slot_used_[job.slot] = false;
+  job.slot = -1;
+  if (!options_.keep_plans) fs::remove(out_ / "plans" / (job.key + ".json"), ec);
+  const fs::path file = out_ / "runs" / (job.key + ".json");
+  if (auto w = WriteFileAtomic(file, RunResultToJson(job.result)); !w) write_error_ = w;
+  results_.erase(std::remove_if(results_.begin(), results_.end(),
+                                [&](const RunResult& r) { return r.spec.Key() == job.key; }),
+                 results_.end());
+  results_.push_back(job.result);
+  Report(job.result, true);
+}
+
+Result<void> SuiteRunner::Close(bool finished) {
+  ShardRecord& record = meta_.shards.front();
+  record.runs_done = static_cast<int>(results_.size());
+  EndSession(record.sessions.back(), record.runs_done);
+  meta_.info = ReportInfo(meta_.shards);
+  if (auto w = WriteFolderMeta(out_, meta_); !w) return w;
+  if (!finished) return {};
+  SortResults(results_);
+  return WriteReport(results_, meta_.info, out_);
+}
+
+Result<std::vector<RunResult>> SuiteRunner::Run() {
   const auto old_int = std::signal(SIGINT, OnInterrupt);
   const auto old_term = std::signal(SIGTERM, OnInterrupt);
   g_interrupted = 0;
-
-  Progress progress;
-  progress.total = static_cast<int>(jobs.size());
-  const Clock::time_point t0 = Clock::now();
-  int fresh_done = 0;
-  std::vector<RunResult> results;
-  const auto report = [&](const RunResult& r, bool fresh) {
-    ++progress.done;
-    if (fresh) ++fresh_done;
-    ++progress.counts[ToString(r.status)];
-    progress.elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
-    const int left = progress.total - progress.done;
-    progress.eta_s = fresh_done > 0 ? progress.elapsed_s / fresh_done * left : -1.0;
-    progress.last = (fresh ? "" : "(reused) ") + Describe(r);
-    if (options.on_progress) options.on_progress(progress);
-  };
-
-  // Runs finished by an earlier, interrupted call are kept.
-  std::vector<size_t> queue;
-  for (size_t i = 0; i < jobs.size(); ++i) {
-    const fs::path file = out / "runs" / (jobs[i].key + ".json");
-    if (fs::exists(file)) {
-      auto text = ReadFile(file);
-      auto r = text ? RunResultFromJson(*text, file.string()) : Result<RunResult>();
-      if (text && r) {
-        results.push_back(*r);
-        report(*r, false);
-        continue;
-      }
-    }
-    queue.push_back(i);
-  }
-  std::reverse(queue.begin(), queue.end());
-
-  const double hard_limit_fallback = options.hard_limit_s;
-  const auto limit_for = [&](const RunSpec& s) {
-    if (hard_limit_fallback > 0.0) return hard_limit_fallback;
-    return s.time_limit_s + std::max(10.0, 0.5 * s.time_limit_s);
-  };
-  const long long as_mib = 4 * options.memory_limit_mib;
-
-  const auto start = [&](Job& job) -> bool {
-    const fs::path log = out / "logs" / (job.key + ".log");
-    std::vector<std::string> argv;
-    if (!job.sim_phase) {
-      fs::remove(log, ec);
-      argv = PlanArgv(job, exe, out, options);
-    } else {
-      argv = {exe.string(),
-              "sim",
-              job.project_file.string(),
-              "--plan",
-              (out / "plans" / (job.key + ".json")).string(),
-              "-o",
-              (out / "sims" / (job.key + ".json")).string()};
-    }
-    {
-      std::ofstream l(log, std::ios::app);
-      for (const std::string& a : argv) l << a << " ";
-      l << "\n";
-    }
-    job.child = Child{};
-    job.child.start = Clock::now();
-    // Simulating a plan takes longer than planning it on a slow machine (MuJoCo steps through
-    // the whole makespan): the sim child gets four times the plan's limit.
-    const double limit_s = limit_for(job.spec) * (job.sim_phase ? 4.0 : 1.0);
-    job.child.deadline =
-        job.child.start + std::chrono::milliseconds(static_cast<long long>(1000 * limit_s));
-    job.child.pid = Spawn(argv, log, as_mib);
-    return job.child.pid > 0;
-  };
-
-  // Classifies a finished child; returns true when the job is complete.
-  const auto finish = [&](Job& job, int wstatus, const rusage& ru) -> bool {
-    RunResult& r = job.result;
-    const fs::path log = out / "logs" / (job.key + ".log");
-    const fs::path plan_file = out / "plans" / (job.key + ".json");
-    const double wall = std::chrono::duration<double>(Clock::now() - job.child.start).count();
-    const bool killed = job.child.term_sent;
-    if (job.sim_phase) {
-      if (killed) {
-        r.sim_success = false;
-        r.sim_failure = "sim killed at the hard limit";
-      } else if (WIFSIGNALED(wstatus) || (WIFEXITED(wstatus) && WEXITSTATUS(wstatus) >= 2)) {
-        r.sim_success = false;
-        r.sim_failure = "sim error: " + WithinOutput(LastLine(log), out);
-      } else {
-        ReadSimReport(r, out / "sims" / (job.key + ".json"));
-      }
-      return true;
-    }
-    r.wall_s = wall;
-    r.peak_rss_mib = static_cast<double>(ru.ru_maxrss) / 1024.0;
-    std::string failure;
-    bool oom = false;
-    ReadPlanStats(r, plan_file, failure, oom);
-    if (killed) {
-      r.status = Status::kTimeout;
-      r.signal = WIFSIGNALED(wstatus) ? WTERMSIG(wstatus) : 0;
-      r.exit_code = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
-      r.message = "killed by the harness after " + Num(std::round(wall * 10) / 10) +
-                  " s (hard limit " + Num(limit_for(job.spec)) + " s)";
-    } else if (WIFSIGNALED(wstatus)) {
-      r.signal = WTERMSIG(wstatus);
-      r.exit_code = -1;
-      r.status = r.signal == SIGKILL ? Status::kOutOfMemory : Status::kCrash;
-      r.message = std::string("signal ") + std::to_string(r.signal) + " (" + strsignal(r.signal) +
-                  ")" + (r.signal == SIGKILL ? ", likely the OOM killer" : "");
-    } else {
-      r.exit_code = WEXITSTATUS(wstatus);
-      switch (r.exit_code) {
-        case 0:
-          r.status = Status::kSolved;
-          break;
-        case 1:
-          r.status = oom ? Status::kOutOfMemory
-                     : failure.starts_with("time limit") || LogMentions(log, "time limit ran out")
-                         ? Status::kTimeout
-                         : Status::kUnsolved;
-          r.message = failure.empty() ? LastLine(log) : failure;
-          break;
-        case 2:
-          r.status = Status::kError;
-          r.message = LastLine(log);
-          break;
-        default:
-          r.status = LogMentions(log, "bad_alloc") || LogMentions(log, "out of memory")
-                         ? Status::kOutOfMemory
-                         : Status::kCrash;
-          r.message = "exit " + std::to_string(r.exit_code) + ": " + LastLine(log);
-      }
-    }
-    r.message = WithinOutput(r.message, out);
-    if (r.message.size() > 400) r.message = r.message.substr(0, 400) + "...";
-    if (r.solved() && job.spec.sim && job.spec.motion) {
-      job.sim_phase = true;
-      return false;
-    }
-    if (job.spec.sim && !r.solved()) {
-      r.sim_success = false;
-      r.sim_failure = "no plan";
-    }
-    return true;
-  };
-
   std::vector<size_t> running;
-  Result<void> write_error;
-  while ((!queue.empty() || !running.empty())) {
+  Clock::time_point next_sample = Clock::now();
+  while (!queue_.empty() || !running.empty()) {
     if (g_interrupted) {
-      for (size_t i : running) kill(-jobs[i].child.pid, SIGKILL);
-      for (size_t i : running) waitpid(jobs[i].child.pid, nullptr, 0);
+      for (size_t i : running) {
+        if (jobs_[i].child.pid <= 0) continue;  // already reaped
+        kill(-jobs_[i].child.pid, SIGKILL);
+        waitpid(jobs_[i].child.pid, nullptr, 0);
+      }
       std::signal(SIGINT, old_int);
       std::signal(SIGTERM, old_term);
-      return Fail(ErrorCode::kCancelled, "interrupted: " + std::to_string(progress.done) + " of " +
-                                             std::to_string(progress.total) + " runs are in " +
-                                             (out / "runs").string() + "; run again to resume");
+      if (auto c = Close(false); !c) return std::unexpected(c.error());
+      return Fail(ErrorCode::kCancelled, "interrupted: " + std::to_string(progress_.done) +
+                                             " of " + std::to_string(progress_.total) +
+                                             " runs are in " + (out_ / "runs").string() +
+                                             "; run again to resume");
     }
-    while (static_cast<int>(running.size()) < options.jobs && !queue.empty()) {
-      const size_t i = queue.back();
-      queue.pop_back();
-      if (!start(jobs[i])) {
-        jobs[i].result.status = Status::kCrash;
-        jobs[i].result.message = "fork failed: " + std::string(std::strerror(errno));
-        results.push_back(jobs[i].result);
-        report(jobs[i].result, true);
+    while (static_cast<int>(running.size()) < options_.jobs && !queue_.empty()) {
+      const size_t i = queue_.back();
+      queue_.pop_back();
+      if (!Start(jobs_[i])) {
+        jobs_[i].result.status = Status::kCrash;
+        jobs_[i].result.message = "fork failed: " + std::string(std::strerror(errno));
+        Record(jobs_[i]);
         continue;
       }
       running.push_back(i);
     }
-    progress.running = static_cast<int>(running.size());
+    progress_.running = static_cast<int>(running.size());
+    // How busy the machine is while plans run (every 0.1 s).
+    if (Clock::now() >= next_sample) {
+      next_sample = Clock::now() + std::chrono::milliseconds(100);
+      if (const double n = RunnableThreads(); n >= 0.0) {
+        for (size_t i : running) {
+          if (jobs_[i].sim_phase) continue;
+          jobs_[i].load_sum += n;
+          ++jobs_[i].load_samples;
+        }
+      }
+    }
     std::vector<size_t> still;
     for (size_t i : running) {
-      Job& job = jobs[i];
+      Job& job = jobs_[i];
       int wstatus = 0;
       rusage ru{};
-      const pid_t w = wait4(job.child.pid, &wstatus, WNOHANG, &ru);
-      if (w == job.child.pid) {
+      if (wait4(job.child.pid, &wstatus, WNOHANG, &ru) == job.child.pid) {
         // The process group may hold grandchildren (none today); end them with it.
         kill(-job.child.pid, SIGKILL);
-        if (!finish(job, wstatus, ru)) {
-          if (start(job)) {
+        // A child stopped by SIGTERM or SIGINT that the harness did not send was stopped with
+        // it (scancel signals every process of the job; Ctrl-C the whole process group): the
+        // run did not end, so it is not recorded, and the suite stops to be resumed.
+        const bool stopped_from_outside =
+            WIFSIGNALED(wstatus) && !job.child.term_sent &&
+            (WTERMSIG(wstatus) == SIGTERM || WTERMSIG(wstatus) == SIGINT);
+        if (g_interrupted || stopped_from_outside) {
+          g_interrupted = 1;
+          job.child.pid = -1;
+          continue;
+        }
+        if (!Finish(job, wstatus, ru)) {
+          if (Start(job)) {
             still.push_back(i);
             continue;
           }
           job.result.sim_success = false;
           job.result.sim_failure = "sim could not start";
         }
-        if (!options.keep_plans) fs::remove(out / "plans" / (job.key + ".json"), ec);
-        const fs::path file = out / "runs" / (job.key + ".json");
-        if (auto wr = WriteFileAtomic(file, RunResultToJson(job.result)); !wr) write_error = wr;
-        results.push_back(job.result);
-        report(job.result, true);
+        Record(job);
         continue;
       }
       const Clock::time_point now = Clock::now();
@@ -583,64 +598,44 @@ Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
   }
   std::signal(SIGINT, old_int);
   std::signal(SIGTERM, old_term);
-  if (!write_error) return std::unexpected(write_error.error());
-
-  info.load += ", at the end " + LoadAverage();
-  if (auto w = WriteFileAtomic(out / "meta.json", InfoToJson(info).dump(2) + "\n"); !w) {
-    return std::unexpected(w.error());
-  }
-  SortResults(results);
-  if (auto w = WriteReport(results, info, out); !w) return std::unexpected(w.error());
-  return results;
+  if (!write_error_) return std::unexpected(write_error_.error());
+  if (auto c = Close(true); !c) return std::unexpected(c.error());
+  return results_;
 }
 
-Result<std::vector<RunResult>> MergeShards(const std::vector<fs::path>& dirs, const fs::path& out) {
-  if (dirs.empty()) return Fail(ErrorCode::kInvalidInput, "merge: no shard folders given");
-  auto results = ReadRunResults(dirs);
-  if (!results) return results;
-  std::error_code ec;
-  fs::create_directories(out / "runs", ec);
-  if (ec) return Fail(ErrorCode::kIo, (out / "runs").string() + ": " + ec.message());
-  for (const RunResult& r : *results) {
-    if (auto w = WriteFileAtomic(out / "runs" / (r.spec.Key() + ".json"), RunResultToJson(r)); !w) {
-      return std::unexpected(w.error());
-    }
+}  // namespace
+
+std::vector<RunSpec> ShardSlice(const std::vector<RunSpec>& specs, int shard_index,
+                                int shard_count) {
+  std::vector<RunSpec> slice;
+  for (size_t i = 0; i < specs.size(); ++i) {
+    if (static_cast<int>(i % shard_count) == shard_index - 1) slice.push_back(specs[i]);
   }
-  // The report names every folder's machine, commit, date, load and settings.
-  RunInfo info;
-  std::set<std::string> machines, commits, dates;
-  std::string loads, settings;
-  for (const fs::path& d : dirs) {
-    auto text = ReadFile(d / "meta.json");
-    if (!text) continue;
-    const Json j = Json::parse(*text, nullptr, false);
-    if (j.is_discarded() || !j.is_object()) continue;
-    const RunInfo i = InfoFromJson(j);
-    const std::string name = fs::absolute(d).lexically_normal().filename().string();
-    machines.insert(i.machine);
-    commits.insert(i.commit);
-    dates.insert(i.date);
-    loads += (loads.empty() ? "" : "; ") + name + ": " + i.load;
-    settings += (settings.empty() ? "" : "; ") + name + ": " + i.settings;
+  return slice;
+}
+
+double LongestRunS(const RunSpec& spec, const BenchOptions& options) {
+  const double plan = PlanHardLimitS(spec, options);
+  return spec.sim ? 5.0 * plan : plan;
+}
+
+Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& all_specs,
+                                        const BenchOptions& given, const fs::path& out) {
+  BenchOptions options = given;
+  if (options.jobs <= 0) options.jobs = std::max(1u, std::thread::hardware_concurrency());
+  if (options.shard_count < 1 || options.shard_index < 1 ||
+      options.shard_index > options.shard_count) {
+    return Fail(ErrorCode::kInvalidInput, "--shard: expected I/N with 1 <= I <= N");
   }
-  const auto join = [](const std::set<std::string>& s) {
-    std::string r;
-    for (const std::string& x : s) r += (r.empty() ? "" : "; ") + x;
-    return r.empty() ? std::string("unknown") : r;
-  };
-  info.machine = join(machines);
-  info.commit = join(commits);
-  info.date = dates.empty() ? "unknown"
-              : dates.size() == 1
-                  ? *dates.begin()
-                  : *dates.begin() + " to " + *dates.rbegin() + " (the folders' starts)";
-  info.load = loads.empty() ? "unknown" : loads;
-  info.settings = "merged from " + std::to_string(dirs.size()) + " folder(s): " + settings;
-  if (auto w = WriteFileAtomic(out / "meta.json", InfoToJson(info).dump(2) + "\n"); !w) {
-    return std::unexpected(w.error());
+  fs::path exe = options.wrap_exe;
+  if (exe.empty()) {
+    std::error_code ec;
+    exe = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) return Fail(ErrorCode::kInternal, "bench: cannot find this executable");
   }
-  if (auto w = WriteReport(*results, info, out); !w) return std::unexpected(w.error());
-  return results;
+  SuiteRunner runner(options, out, fs::absolute(exe));
+  if (auto p = runner.Prepare(all_specs); !p) return std::unexpected(p.error());
+  return runner.Run();
 }
 
 }  // namespace wrap::bench
