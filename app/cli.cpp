@@ -137,7 +137,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   bench->add_option("--suite", bench_args.suite,
                     "paper (comparison, breakdown, convergence on cross, stool, chair), fabrica, "
                     "scaling (robots, wrench models, parts), ablation (wrench models simulated), "
-                    "all, or tiny (the test suite's)");
+                    "all, smoke (every section once, small, on the cross: minutes) or tiny (the "
+                    "test suite's)");
   bench->add_option("--runs", bench_args.runs, "Seeds per configuration (default 3)")
       ->check(CLI::PositiveNumber);
   CLI::Option* bench_time_option = bench->add_option(

@@ -116,7 +116,7 @@ int Sim(const SimArgs& args, std::ostream& out, std::ostream& err);
 
 /// Arguments of `wrap bench` and `wrap bench merge`.
 struct BenchArgs {
-  std::string suite = "paper";           ///< --suite paper|fabrica|scaling|ablation|all|tiny.
+  std::string suite = "paper";           ///< --suite paper|fabrica|scaling|ablation|all|smoke|tiny.
   int runs = 3;                          ///< --runs: seeds per configuration.
   std::optional<double> time_limit_s;    ///< --time-limit [s]; absent: the suite's default.
   int jobs = 0;                          ///< --jobs; 0: the number of cores.

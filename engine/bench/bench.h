@@ -114,7 +114,7 @@ struct Progress {
 
 /// Options of a suite run.
 struct BenchOptions {
-  std::string suite = "paper";         ///< paper, fabrica, scaling, ablation, all, tiny.
+  std::string suite = "paper";         ///< paper, fabrica, scaling, ablation, all, smoke, tiny.
   int runs = 3;                        ///< Seeds 0..runs-1 per configuration.
   std::optional<double> time_limit_s;  ///< Planner time limit; absent: each suite's default.
   int jobs = 0;                        ///< Runs at once; 0: the number of cores.

@@ -129,9 +129,11 @@ class ReportBuilder : public ReportBlocks {
       wall += r.wall_s + r.sim_wall_s;
       cpu += r.cpu_s;
     }
-    Para("The runs took " + Fmt("%.2f", wall / 3600.0) + " h of run time (plan and simulation "
-         "children, wall clock, summed over the runs) and " + Fmt("%.2f", cpu / 3600.0) +
-         " h of CPU time.");
+    const auto hours = [](double s) {
+      return s < 3600.0 ? Fmt("%.1f", s / 60.0) + " min" : Fmt("%.2f", s / 3600.0) + " h";
+    };
+    Para("The runs took " + hours(wall) + " of run time (plan and simulation children, wall "
+         "clock, summed over the runs) and " + hours(cpu) + " of CPU time.");
   }
 
   void Comparison() {
@@ -274,6 +276,10 @@ class ReportBuilder : public ReportBlocks {
     std::vector<std::string> models = {"no wrench", "gravity only"};
     for (double l : {0.0, 0.01, 0.1, 0.5, 1.0, 2.0}) models.push_back("λ = " + Fmt("%g", l));
     for (const std::string base : {"cross", "cube_2x2x3"}) {
+      if (std::none_of(runs.begin(), runs.end(),
+                       [&](const RunResult* r) { return r->spec.project.base == base; })) {
+        continue;  // not in this suite
+      }
       LinePlot plot;
       plot.title = base == "cross" ? "Cross, two-finger grippers" : "Cube 2x2x3, vacuum grippers";
       plot.x_label = "robots";

@@ -66,6 +66,7 @@ void OwnMeasures(const std::vector<RunResult>& results, ReportBlocks& report) {
   plot.x_label = "time [% of the makespan]";
   plot.y_label = "robots moving (mean)";
   plot.x_ticks = {0, 25, 50, 75, 100};
+  plot.y_from_zero = true;
   int color = 0;
   for (const std::string& p : ProjectOrder(names)) {
     const auto it = by_project.find(p);

@@ -126,6 +126,44 @@ void AblationSuite(std::vector<RunSpec>& out, int runs, double limit) {
   }
 }
 
+// Every section of the report from one seed of small configurations of each study, on the
+// cross (a few minutes on one core): to check a build or a cluster set-up before a long study.
+void SmokeSuite(std::vector<RunSpec>& out, int runs, double task_limit, double motion_limit) {
+  const ProjectSpec cross = Example("cross", "comparison");
+  for (const std::string& planner : kPlanners) {
+    AddSeeds(out, Spec(cross, planner, "comparison", task_limit), runs);
+  }
+  for (const std::string wrench : {"none", "full"}) {
+    RunSpec spec = Spec(Example("cross", "ablation"), "wrap", "ablation", motion_limit);
+    spec.wrench = wrench;
+    spec.motion = spec.sim = true;
+    AddSeeds(out, spec, runs);
+  }
+  for (int robots : {2, 3}) {
+    for (const std::string wrench : {"none", "full"}) {
+      RunSpec spec = Spec({"cross_r" + std::to_string(robots), "cross", robots, 0,
+                           "scaling_robots"},
+                          "wrap", "scaling_robots", task_limit);
+      spec.wrench = wrench;
+      AddSeeds(out, spec, runs);
+    }
+  }
+  RunSpec none = Spec(cross, "wrap", "scaling_robots", task_limit);
+  none.wrench = "none";
+  AddSeeds(out, none, runs);
+  for (int arms : {1, 3}) {
+    AddSeeds(out,
+             Spec({"cross_arms" + std::to_string(arms), "cross", 0, arms, "scaling_parts"}, "wrap",
+                  "scaling_parts", task_limit),
+             runs);
+  }
+  for (const std::string planner : {"wrap", "counting"}) {
+    RunSpec spec = Spec(Example("cross", "convergence"), planner, "convergence", task_limit);
+    spec.optimize = true;
+    AddSeeds(out, spec, runs);
+  }
+}
+
 }  // namespace
 
 std::string RunSpec::Options() const {
@@ -185,11 +223,12 @@ void SortResults(std::vector<RunResult>& results) {
 
 Result<std::vector<RunSpec>> MakeSuite(const BenchOptions& options) {
   if (options.runs < 1) return Fail(ErrorCode::kInvalidInput, "--runs: must be at least 1");
-  const std::set<std::string> known = {"paper", "fabrica", "scaling", "ablation", "all", "tiny"};
+  const std::set<std::string> known = {"paper", "fabrica", "scaling", "ablation",
+                                       "all",   "tiny",    "smoke"};
   if (!known.contains(options.suite)) {
     return Fail(ErrorCode::kInvalidInput,
                 "--suite: unknown suite '" + options.suite +
-                    "' (expected paper, fabrica, scaling, ablation, all or tiny)");
+                    "' (expected paper, fabrica, scaling, ablation, all, smoke or tiny)");
   }
   const auto limit = [&](double fallback) { return options.time_limit_s.value_or(fallback); };
   std::vector<RunSpec> specs;
@@ -202,6 +241,7 @@ Result<std::vector<RunSpec>> MakeSuite(const BenchOptions& options) {
     }
   }
   // Task plans get 30 s; plans with motion (then simulated) 60 s.
+  if (s == "smoke") SmokeSuite(specs, options.runs, limit(10), limit(60));
   if (s == "paper" || s == "all") PaperSuite(specs, options.runs, limit(30), limit(60));
   if (s == "fabrica" || s == "all") FabricaSuite(specs, options.runs, limit(30), limit(60));
   if (s == "scaling" || s == "all") ScalingSuite(specs, options.runs, limit(30));

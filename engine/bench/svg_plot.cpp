@@ -84,6 +84,7 @@ std::string RenderSvg(const LinePlot& plot) {
     x0 = std::min(x0, t);
     x1 = std::max(x1, t);
   }
+  if (plot.y_from_zero && !plot.log_y && std::isfinite(y0)) y0 = std::min(y0, 0.0);
   std::ostringstream o;
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
     << "\" viewBox=\"0 0 " << W << " " << H << "\" font-family=\"sans-serif\" font-size=\"11\">\n";
@@ -115,8 +116,9 @@ std::string RenderSvg(const LinePlot& plot) {
       y1 += 1.0;
     }
     const double m = 0.08 * (y1 - y0);
-    yticks = NiceTicks(y0 - m, y1 + m);
-    y0 = std::min(y0 - m, yticks.front());
+    const double m_low = plot.y_from_zero && y0 == 0.0 ? 0.0 : m;  // the axis starts at 0
+    yticks = NiceTicks(y0 - m_low, y1 + m);
+    y0 = std::min(y0 - m_low, yticks.front());
     y1 = std::max(y1 + m, yticks.back());
   }
   const double xm = plot.x_ticks.empty() ? 0.0 : 0.05 * (x1 - x0);

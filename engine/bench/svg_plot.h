@@ -25,6 +25,7 @@ struct LinePlot {
   std::string x_label;             ///< Under the x axis.
   std::string y_label;             ///< Beside the y axis.
   bool log_y = false;              ///< Logarithmic y axis (points with y <= 0 are left out).
+  bool y_from_zero = false;        ///< A linear y axis that starts at 0 (counts, shares).
   std::vector<double> x_ticks;     ///< Fixed x ticks; empty: automatic.
   std::vector<PlotSeries> series;  ///< The lines.
   int width_px = 620;              ///< Image size [px].
