@@ -69,8 +69,9 @@ int DryRun(const std::vector<bench::RunSpec>& specs, const bench::BenchOptions& 
     longest += t;
     out << s.Key() << "  (at most " << Duration(t) << ")\n";
   }
-  const int jobs =
-      options.jobs > 0 ? options.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int jobs = options.jobs > 0
+                       ? options.jobs
+                       : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   out << "Suite '" << options.suite << "': " << specs.size() << " runs; shard "
       << options.shard_index << "/" << options.shard_count << ": " << slice.size()
       << " runs, at most " << Duration(longest) << " of run time (every run at its hard limit; "

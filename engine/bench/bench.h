@@ -74,8 +74,8 @@ struct RunResult {
   int signal = 0;                  ///< Signal that ended the child, 0 if none.
   double wall_s = 0.0;             ///< Wall time of the plan child [s].
   double peak_rss_mib = 0.0;       ///< Peak resident memory of the plan child (wait4) [MiB].
-  double cpu_s = 0.0;   ///< CPU time (user + system) of its children, plan and sim [s].
-  double sim_wall_s = 0.0;  ///< Wall time of the sim child [s]; 0 when not simulated.
+  double cpu_s = 0.0;              ///< CPU time (user + system) of its children, plan and sim [s].
+  double sim_wall_s = 0.0;         ///< Wall time of the sim child [s]; 0 when not simulated.
   /// The plan's stats by name (cost, first_cost, t_init_s, t_grasp_s, t_bwd_s, t_lp_s, t_fwd_s,
   /// t_ik_s, t_kf_s, t_mp_s, t_retime_s, t_opt_s, makespan_s); absent where the plan gave none.
   std::map<std::string, double> stats;
@@ -154,10 +154,11 @@ double LongestRunS(const RunSpec& spec, const BenchOptions& options);
 /// it (a second one is refused, naming the first), and its meta.json records the shard's
 /// identity (revision of this build, suite, seeds, limits, shard, the suite's runs and the
 /// projects' contents); resuming it with another identity is refused, naming what differs.
-/// Children run pinned to their own cores where the cores suffice, and die with the harness. Classification: killed by the hard limit -> timeout;
-/// exit 0 -> solved; exit 1 -> unsolved, or timeout when the planner stopped at its limit, or
-/// oom when it stopped at its memory limit; exit 2 -> error; other exits and signals -> crash
-/// (oom when the log shows an allocation failure). Fails with kIo when `out` cannot be written.
+/// Children run pinned to their own cores where the cores suffice, and die with the harness.
+/// Classification: killed by the hard limit -> timeout; exit 0 -> solved; exit 1 -> unsolved, or
+/// timeout when the planner stopped at its limit, or oom when it stopped at its memory limit; exit
+/// 2 -> error; other exits and signals -> crash (oom when the log shows an allocation failure).
+/// Fails with kIo when `out` cannot be written.
 Result<std::vector<RunResult>> RunSuite(const std::vector<RunSpec>& specs,
                                         const BenchOptions& options,
                                         const std::filesystem::path& out);

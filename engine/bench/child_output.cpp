@@ -53,8 +53,8 @@ double Utilisation::MeanMoving() const {
 
 std::optional<Utilisation> UtilisationOfPlan(const std::string& plan_json) {
   const Json j = Json::parse(plan_json, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("segments") ||
-      !j["segments"].is_array() || !j.contains("robots") || !j["robots"].is_array()) {
+  if (j.is_discarded() || !j.is_object() || !j.contains("segments") || !j["segments"].is_array() ||
+      !j.contains("robots") || !j["robots"].is_array()) {
     return std::nullopt;
   }
   std::map<std::string, Intervals> busy;

@@ -61,18 +61,19 @@ Verdict Check(const std::vector<Entry>& entries) {
       std::erase_if(d, [](const std::string& s) { return s.starts_with("revision"); });
       if (d.empty()) continue;
       consistent = false;
-      v.problems.push_back(e->dir + " (" + e->record.id.Describe() + ") was run with other "
-                           "settings than " + first.dir + " (" + first.record.id.Describe() +
-                           "): " + Join(d, "; ") + " (here: " + e->dir + ", there: " +
-                           first.dir + ")");
+      v.problems.push_back(e->dir + " (" + e->record.id.Describe() +
+                           ") was run with other "
+                           "settings than " +
+                           first.dir + " (" + first.record.id.Describe() + "): " + Join(d, "; ") +
+                           " (here: " + e->dir + ", there: " + first.dir + ")");
     }
     if (!consistent) continue;
     const int n = first.record.id.shard_count;
     std::map<int, std::vector<const Entry*>> by_index;
     for (const Entry* e : list) by_index[e->record.id.shard_index].push_back(e);
     for (int i = 1; i <= n; ++i) {
-      const std::string what = "shard " + std::to_string(i) + "/" + std::to_string(n) +
-                               " of suite '" + suite + "'";
+      const std::string what =
+          "shard " + std::to_string(i) + "/" + std::to_string(n) + " of suite '" + suite + "'";
       const auto it = by_index.find(i);
       if (it == by_index.end()) {
         v.gaps.push_back(what + " is missing (no folder given holds it)");
@@ -111,9 +112,9 @@ RunInfo ReportInfo(const std::vector<ShardRecord>& records) {
       machines.insert(s.machine);
       starts.insert(s.start);
       if (!s.end.empty()) ends.insert(s.end);
-      std::string load = "at the start " + s.load_start + ", " +
-                         (s.end.empty() ? std::string("stopped before its end")
-                                        : "at the end " + s.load_end);
+      std::string load =
+          "at the start " + s.load_start + ", " +
+          (s.end.empty() ? std::string("stopped before its end") : "at the end " + s.load_end);
       if (records.size() > 1) load = r.id.Describe() + " on " + s.host + ": " + load;
       loads.push_back(load);
     }
@@ -204,8 +205,7 @@ Result<std::vector<RunResult>> MergeShards(const std::vector<fs::path>& dirs, co
   auto lock = FolderLock::Acquire(out);
   if (!lock) return std::unexpected(lock.error());
   if (auto old = ReadFolderMeta(out); old && old->kind == "shard") {
-    return Fail(ErrorCode::kInvalidInput, "merge: -o " + out.string() +
-                                              " is a shard's folder (" +
+    return Fail(ErrorCode::kInvalidInput, "merge: -o " + out.string() + " is a shard's folder (" +
                                               old->shards.front().id.Describe() +
                                               "); give a new or a merged folder");
   }
@@ -214,8 +214,7 @@ Result<std::vector<RunResult>> MergeShards(const std::vector<fs::path>& dirs, co
     if (e.path().extension() == ".json") fs::remove(e.path(), ec);
   }
   for (const RunResult& r : all) {
-    if (auto w = WriteFileAtomic(out / "runs" / (r.spec.Key() + ".json"), RunResultToJson(r));
-        !w) {
+    if (auto w = WriteFileAtomic(out / "runs" / (r.spec.Key() + ".json"), RunResultToJson(r)); !w) {
       return std::unexpected(w.error());
     }
   }

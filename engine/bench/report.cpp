@@ -132,8 +132,10 @@ class ReportBuilder : public ReportBlocks {
     const auto hours = [](double s) {
       return s < 3600.0 ? Fmt("%.1f", s / 60.0) + " min" : Fmt("%.2f", s / 3600.0) + " h";
     };
-    Para("The runs took " + hours(wall) + " of run time (plan and simulation children, wall "
-         "clock, summed over the runs) and " + hours(cpu) + " of CPU time.");
+    Para("The runs took " + hours(wall) +
+         " of run time (plan and simulation children, wall "
+         "clock, summed over the runs) and " +
+         hours(cpu) + " of CPU time.");
   }
 
   void Comparison() {
@@ -204,8 +206,8 @@ class ReportBuilder : public ReportBlocks {
       if (!projects.contains(p)) continue;
       auto runs = Select([&](const RunResult& r) {
         return r.spec.project.name == p && r.spec.planner == "wrap" && r.spec.motion &&
-               !r.spec.optimize && r.spec.wrench == "full" &&
-               r.spec.force_scale == 1.0 && r.spec.project.robots == 0 && r.spec.project.steps == 0;
+               !r.spec.optimize && r.spec.wrench == "full" && r.spec.force_scale == 1.0 &&
+               r.spec.project.robots == 0 && r.spec.project.steps == 0;
       });
       const bool with_motion = !runs.empty();
       if (!with_motion) {

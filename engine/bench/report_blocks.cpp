@@ -118,7 +118,6 @@ std::string ToHtml(const std::vector<Block>& blocks) {
   return o.str();
 }
 
-
 void ReportBlocks::Heading(int level, const std::string& text) {
   Block b;
   b.kind = Block::kHeading;
@@ -197,8 +196,8 @@ std::vector<double> Values(const std::vector<const RunResult*>& runs, const std:
 }
 
 std::string LoadedMark(const std::vector<const RunResult*>& runs) {
-  const auto n = std::count_if(runs.begin(), runs.end(),
-                               [](const RunResult* r) { return r->loaded(); });
+  const auto n =
+      std::count_if(runs.begin(), runs.end(), [](const RunResult* r) { return r->loaded(); });
   return n == 0 ? "" : " †" + std::to_string(n);
 }
 

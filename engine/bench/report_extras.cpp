@@ -11,9 +11,8 @@ namespace wrap::bench {
 namespace {
 
 bool IsOwnMeasureRun(const RunResult& r) {
-  return r.spec.planner == "wrap" && r.spec.motion && !r.spec.optimize &&
-         r.spec.wrench == "full" && r.spec.force_scale == 1.0 && r.spec.project.robots == 0 &&
-         r.spec.project.steps == 0;
+  return r.spec.planner == "wrap" && r.spec.motion && !r.spec.optimize && r.spec.wrench == "full" &&
+         r.spec.force_scale == 1.0 && r.spec.project.robots == 0 && r.spec.project.steps == 0;
 }
 
 // The simulation columns of one assembly: runs simulated, held, actions completed, failures.
@@ -99,8 +98,8 @@ void OwnMeasures(const std::vector<RunResult>& results, ReportBlocks& report) {
     std::vector<std::string> row = {
         PaperProjectName(p),
         std::to_string(solved) + "/" + std::to_string(runs.size()) + LoadedMark(runs),
-        MeanStd(Summarise(Values(runs, "makespan_s")), "%.1f"),
-        MeanStd(Summarise(moving), "%.0f"), MeanStd(Summarise(busiest), "%.1f")};
+        MeanStd(Summarise(Values(runs, "makespan_s")), "%.1f"), MeanStd(Summarise(moving), "%.0f"),
+        MeanStd(Summarise(busiest), "%.1f")};
     for (const std::string& c : SimCells(runs)) row.push_back(c);
     rows.push_back(row);
   }

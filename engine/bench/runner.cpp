@@ -132,8 +132,8 @@ struct Job {
   RunResult result;
   Child child;
   bool sim_phase = false;
-  int slot = -1;            // which of the `jobs` core sets it runs on
-  double load_sum = 0.0;    // runnable threads summed over the plan phase's samples
+  int slot = -1;          // which of the `jobs` core sets it runs on
+  double load_sum = 0.0;  // runnable threads summed over the plan phase's samples
   int load_samples = 0;
 };
 
@@ -235,8 +235,9 @@ Result<void> SuiteRunner::Prepare(const std::vector<RunSpec>& all_specs) {
     auto old = ReadFolderMeta(out_);
     if (!old) return std::unexpected(old.error());
     if (old->kind != "shard") {
-      return Fail(ErrorCode::kInvalidInput, out_.string() + ": holds a merged report, not a "
-                                                            "shard: give `wrap bench` a new -o");
+      return Fail(ErrorCode::kInvalidInput, out_.string() +
+                                                ": holds a merged report, not a "
+                                                "shard: give `wrap bench` a new -o");
     }
     const auto d = Differences(id, old->shards.front().id, true);
     if (!d.empty()) {
@@ -251,8 +252,9 @@ Result<void> SuiteRunner::Prepare(const std::vector<RunSpec>& all_specs) {
     meta_ = *old;
   } else if (fs::exists(out_ / "runs") && !fs::is_empty(out_ / "runs", ec)) {
     return Fail(ErrorCode::kInvalidInput,
-                out_.string() + ": has runs but no meta.json (an older `wrap bench`'s folder?): "
-                                "give another -o");
+                out_.string() +
+                    ": has runs but no meta.json (an older `wrap bench`'s folder?): "
+                    "give another -o");
   } else {
     meta_.shards = {ShardRecord{id, {}, 0}};
   }
@@ -262,7 +264,8 @@ Result<void> SuiteRunner::Prepare(const std::vector<RunSpec>& all_specs) {
   for (const char* sub : {"runs", "plans", "logs", "sims", "projects"}) {
     fs::create_directories(out_ / sub, ec);
     if (ec) {
-      return Fail(ErrorCode::kIo, (out_ / sub).string() + ": cannot create folder: " + ec.message());
+      return Fail(ErrorCode::kIo,
+                  (out_ / sub).string() + ": cannot create folder: " + ec.message());
     }
   }
   // Temporary files of a write that a killed process left behind (never a result).
@@ -393,8 +396,8 @@ bool SuiteRunner::Start(Job& job) {
   job.child.deadline =
       job.child.start + std::chrono::milliseconds(static_cast<long long>(1000 * limit_s));
   static const std::vector<int> kAnyCpu;
-  job.child.pid = Spawn(argv, log, 4 * options_.memory_limit_mib,
-                        job.slot >= 0 ? slots_[job.slot] : kAnyCpu);
+  job.child.pid =
+      Spawn(argv, log, 4 * options_.memory_limit_mib, job.slot >= 0 ? slots_[job.slot] : kAnyCpu);
   return job.child.pid > 0;
 }
 
@@ -424,11 +427,11 @@ void SuiteRunner::ClassifyPlan(Job& job, int wstatus, const rusage& ru, double w
         r.status = Status::kSolved;
         break;
       case 1:
-        r.status = plan.out_of_memory ? Status::kOutOfMemory
-                   : plan.failure.starts_with("time limit") ||
-                           LogMentions(log, "time limit ran out")
-                       ? Status::kTimeout
-                       : Status::kUnsolved;
+        r.status =
+            plan.out_of_memory ? Status::kOutOfMemory
+            : plan.failure.starts_with("time limit") || LogMentions(log, "time limit ran out")
+                ? Status::kTimeout
+                : Status::kUnsolved;
         r.message = plan.failure.empty() ? LastLine(log) : plan.failure;
         break;
       case 2:
@@ -524,10 +527,9 @@ Result<std::vector<RunResult>> SuiteRunner::Run() {
       std::signal(SIGINT, old_int);
       std::signal(SIGTERM, old_term);
       if (auto c = Close(false); !c) return std::unexpected(c.error());
-      return Fail(ErrorCode::kCancelled, "interrupted: " + std::to_string(progress_.done) +
-                                             " of " + std::to_string(progress_.total) +
-                                             " runs are in " + (out_ / "runs").string() +
-                                             "; run again to resume");
+      return Fail(ErrorCode::kCancelled, "interrupted: " + std::to_string(progress_.done) + " of " +
+                                             std::to_string(progress_.total) + " runs are in " +
+                                             (out_ / "runs").string() + "; run again to resume");
     }
     while (static_cast<int>(running.size()) < options_.jobs && !queue_.empty()) {
       const size_t i = queue_.back();

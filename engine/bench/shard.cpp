@@ -182,8 +182,8 @@ std::vector<std::string> Differences(const ShardId& here, const ShardId& there, 
     differ("shard (--shard I/N)", std::to_string(here.shard_index),
            std::to_string(there.shard_index));
   }
-  if (d.empty() && (here.suite_runs != there.suite_runs ||
-                    here.suite_fingerprint != there.suite_fingerprint)) {
+  if (d.empty() &&
+      (here.suite_runs != there.suite_runs || here.suite_fingerprint != there.suite_fingerprint)) {
     d.push_back("the suite's runs: " + std::to_string(here.suite_runs) + " here (" +
                 here.suite_fingerprint + "), " + std::to_string(there.suite_runs) + " there (" +
                 there.suite_fingerprint + ")");
@@ -321,8 +321,8 @@ Result<void> WriteFolderMeta(const fs::path& dir, const FolderMeta& meta) {
         Json{{"id", IdToJson(r.id)}, {"runs_done", r.runs_done}, {"sessions", sessions}});
   }
   j["shards"] = shards;
-  j["report"] = Json{{"machine", meta.info.machine}, {"load", meta.info.load},
-                     {"commit", meta.info.commit},   {"date", meta.info.date},
+  j["report"] = Json{{"machine", meta.info.machine},   {"load", meta.info.load},
+                     {"commit", meta.info.commit},     {"date", meta.info.date},
                      {"settings", meta.info.settings}, {"caveats", meta.info.caveats}};
   return WriteFileAtomic(dir / "meta.json", j.dump(2) + "\n");
 }

@@ -39,15 +39,15 @@ std::vector<std::string> Differences(const ShardId& here, const ShardId& there, 
 
 /// One process's work on a folder.
 struct Session {
-  std::string host;          ///< Host name.
-  std::string machine;       ///< CPU model, cores, memory, OS.
-  int cores = 0;             ///< Online CPUs.
-  int jobs = 0;              ///< Runs at once.
-  std::string start, end;    ///< UTC date and time; end empty while running or when killed.
-  std::string load_start;    ///< Load averages (1, 5, 15 min) at the start.
-  std::string load_end;      ///< ... and at the end; empty when killed.
-  std::string slurm_job;     ///< SLURM_JOB_ID (and array job and task), or empty.
-  int runs_done = 0;         ///< Runs with results when the session ended.
+  std::string host;        ///< Host name.
+  std::string machine;     ///< CPU model, cores, memory, OS.
+  int cores = 0;           ///< Online CPUs.
+  int jobs = 0;            ///< Runs at once.
+  std::string start, end;  ///< UTC date and time; end empty while running or when killed.
+  std::string load_start;  ///< Load averages (1, 5, 15 min) at the start.
+  std::string load_end;    ///< ... and at the end; empty when killed.
+  std::string slurm_job;   ///< SLURM_JOB_ID (and array job and task), or empty.
+  int runs_done = 0;       ///< Runs with results when the session ended.
 };
 
 /// One shard's record in meta.json.

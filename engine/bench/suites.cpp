@@ -141,9 +141,9 @@ void SmokeSuite(std::vector<RunSpec>& out, int runs, double task_limit, double m
   }
   for (int robots : {2, 3}) {
     for (const std::string wrench : {"none", "full"}) {
-      RunSpec spec = Spec({"cross_r" + std::to_string(robots), "cross", robots, 0,
-                           "scaling_robots"},
-                          "wrap", "scaling_robots", task_limit);
+      RunSpec spec =
+          Spec({"cross_r" + std::to_string(robots), "cross", robots, 0, "scaling_robots"}, "wrap",
+               "scaling_robots", task_limit);
       spec.wrench = wrench;
       AddSeeds(out, spec, runs);
     }

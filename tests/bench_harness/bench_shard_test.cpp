@@ -256,8 +256,7 @@ TEST(BenchMerge, RefusesMissingDuplicatedAndUnfinishedShardsUnlessPartial) {
   TwoShards s(tmp.path());
   auto missing = Merge({s.a}, tmp.path() / "m");
   ASSERT_FALSE(missing.has_value());
-  EXPECT_NE(missing.error().message.find("shard 2/2 of suite 'tiny' is missing"),
-            std::string::npos)
+  EXPECT_NE(missing.error().message.find("shard 2/2 of suite 'tiny' is missing"), std::string::npos)
       << missing.error().message;
   EXPECT_NE(missing.error().message.find("--partial"), std::string::npos);
 
@@ -335,13 +334,12 @@ TEST(BenchLoad, LoadedRunsAreMarkedAndRunAgainOnRequest) {
 TEST(BenchUtilisation, RobotsMovingFromThePlansSegments) {
   // Two robots over a 10 s makespan: a moves in [0, 2] and [1, 3] (overlapping: 3 s), b in
   // [4, 5]; c never moves.
-  const Json plan = {
-      {"robots", {"a", "b", "c"}},
-      {"stats", {{"makespan_s", 10.0}}},
-      {"segments",
-       {{{"kind", "free"}, {"robots", {"a"}}, {"start_s", 0.0}, {"end_s", 2.0}},
-        {{"kind", "carry"}, {"robots", {"a"}}, {"start_s", 1.0}, {"end_s", 3.0}},
-        {{"kind", "insert"}, {"robots", {"b"}}, {"start_s", 4.0}, {"end_s", 5.0}}}}};
+  const Json plan = {{"robots", {"a", "b", "c"}},
+                     {"stats", {{"makespan_s", 10.0}}},
+                     {"segments",
+                      {{{"kind", "free"}, {"robots", {"a"}}, {"start_s", 0.0}, {"end_s", 2.0}},
+                       {{"kind", "carry"}, {"robots", {"a"}}, {"start_s", 1.0}, {"end_s", 3.0}},
+                       {{"kind", "insert"}, {"robots", {"b"}}, {"start_s", 4.0}, {"end_s", 5.0}}}}};
   const auto u = UtilisationOfPlan(plan.dump());
   ASSERT_TRUE(u.has_value());
   EXPECT_NEAR(u->moving.at("a"), 0.3, 1e-12);
@@ -405,8 +403,8 @@ TEST(BenchCli, DryRunSizesAShard) {
   const auto all = MakeSuite(o);
   ASSERT_TRUE(all.has_value());
   const auto slice = ShardSlice(*all, 3, 40);
-  EXPECT_NE(text.find("Suite 'all': " + std::to_string(all->size()) + " runs; shard 3/40: " +
-                      std::to_string(slice.size()) + " runs"),
+  EXPECT_NE(text.find("Suite 'all': " + std::to_string(all->size()) +
+                      " runs; shard 3/40: " + std::to_string(slice.size()) + " runs"),
             std::string::npos)
       << text;
   double longest = 0.0;
