@@ -260,6 +260,7 @@ Result<void> SuiteRunner::Prepare(const std::vector<RunSpec>& all_specs) {
   }
   meta_.kind = "shard";
   meta_.shards.front().sessions.push_back(StartSession(options_.jobs));
+  meta_.shards.front().sessions.back().unlocked = !lock_->held();
 
   for (const char* sub : {"runs", "plans", "logs", "sims", "projects"}) {
     fs::create_directories(out_ / sub, ec);

@@ -135,6 +135,7 @@ Json SessionToJson(const Session& s) {
               {"load_start", s.load_start},
               {"load_end", s.load_end},
               {"slurm_job", s.slurm_job},
+              {"unlocked", s.unlocked},
               {"runs_done", s.runs_done}};
 }
 
@@ -149,6 +150,7 @@ Session SessionFromJson(const Json& j) {
   s.load_start = j.value("load_start", "");
   s.load_end = j.value("load_end", "");
   s.slurm_job = j.value("slurm_job", "");
+  s.unlocked = j.value("unlocked", false);
   s.runs_done = j.value("runs_done", 0);
   return s;
 }
@@ -333,7 +335,14 @@ Result<FolderLock> FolderLock::Acquire(const fs::path& dir) {
   if (fd < 0) {
     return Fail(ErrorCode::kIo, file.string() + ": cannot open: " + std::strerror(errno));
   }
-  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+  bool held = true;
+  const int locked = ::flock(fd, LOCK_EX | LOCK_NB);
+  const int why = errno;
+  if (locked != 0 && why != EWOULDBLOCK) {
+    // A file system without flock (Lustre mounted without it, some NFS set-ups): the folder
+    // cannot be guarded; the shard goes on unguarded, as its session records.
+    held = false;
+  } else if (locked != 0) {
     std::string holder;
     char buf[512] = {};
     if (::pread(fd, buf, sizeof buf - 1, 0) > 0) holder = buf;
@@ -354,10 +363,12 @@ Result<FolderLock> FolderLock::Acquire(const fs::path& dir) {
   if (::ftruncate(fd, 0) == 0) {
     [[maybe_unused]] const ssize_t n = ::pwrite(fd, holder.data(), holder.size(), 0);
   }
-  return FolderLock(fd);
+  return FolderLock(fd, held);
 }
 
-FolderLock::FolderLock(FolderLock&& other) noexcept : fd_(other.fd_) { other.fd_ = -1; }
+FolderLock::FolderLock(FolderLock&& other) noexcept : fd_(other.fd_), held_(other.held_) {
+  other.fd_ = -1;
+}
 
 FolderLock::~FolderLock() {
   if (fd_ >= 0) ::close(fd_);  // closing the descriptor releases the flock

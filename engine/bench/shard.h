@@ -99,10 +99,14 @@ class FolderLock {
   FolderLock& operator=(FolderLock&&) = delete;
   FolderLock(const FolderLock&) = delete;
   ~FolderLock();
+  /// False where the file system does not lock (no flock: Lustre without it, some NFS set-ups):
+  /// then nothing keeps a second process out, which the session records.
+  bool held() const { return held_; }
 
  private:
-  explicit FolderLock(int fd) : fd_(fd) {}
+  FolderLock(int fd, bool held) : fd_(fd), held_(held) {}
   int fd_ = -1;
+  bool held_ = true;
 };
 
 }  // namespace wrap::bench

@@ -13,10 +13,18 @@ repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 wrap=$(cd "$(dirname "${1:-$repo/build/app/wrap}")" && pwd)/$(basename "${1:-$repo/build/app/wrap}")
 start_time=$SECONDS
 # The suite: task plans of the cross by two planners, 5 seeds (10 runs; shards of 4, 3 and 3).
-suite=(--suite tiny --runs 5 --time-limit 10)
+# Each takes a second or two; the limit is generous so that a loaded machine does not turn a
+# plan into a timeout in one of the two runs that are compared.
+suite=(--suite tiny --runs 5 --time-limit 60)
 runs=10
 
 fail() { echo "cluster-test: FAILED: $*" >&2; exit 1; }
+# Runs a command in the background and waits for it, so that a signal to this script is handled
+# at once (bash defers traps until a foreground command ends).
+bg() {
+  "$@" &
+  wait $!
+}
 say() { echo "cluster-test: [$((SECONDS - start_time)) s] $*"; }
 
 [[ -x "$wrap" ]] || fail "no wrap at $wrap (build first)"
@@ -55,7 +63,7 @@ stop_all() {
     kill -9 "$pid" 2>/dev/null
   done
   # Anything of this test's jobs still running (its command line names this test's folder).
-  for pid in $(pgrep -f "$tmp/" 2>/dev/null); do
+  for pid in $(command -v pgrep >/dev/null && pgrep -f "$tmp/"); do
     [[ "$pid" != "$$" ]] && kill -9 "$pid" 2>/dev/null
   done
   if [[ $rc -ne 0 ]]; then
@@ -128,7 +136,7 @@ done
 say "Slurm up: 1 node, $cpus CPUs, ports ${ports[*]}"
 
 # The reference: one process, the whole suite.
-"$wrap" bench "${suite[@]}" --jobs "$cpus" --projects "$repo/projects" -o "$tmp/single" \
+bg "$wrap" bench "${suite[@]}" --jobs "$cpus" --projects "$repo/projects" -o "$tmp/single" \
   >"$tmp/log/single.log" 2>&1 || fail "the one-process suite failed: $(tail -n 5 "$tmp/log/single.log")"
 say "one process: $runs runs"
 
@@ -189,7 +197,7 @@ grep -q "shard-2 (shard 2/3 of suite 'tiny') has $done_at_cancel of its 3 runs" 
 say "merge refused the unfinished shard"
 
 # Task 2 again: it resumes from its finished runs; the new merge job merges.
-"$repo/scripts/slurm/submit.sh" --resubmit "$tmp/study" --tasks 2 --cpus-per-task 1 --wait ||
+bg "$repo/scripts/slurm/submit.sh" --resubmit "$tmp/study" --tasks 2 --cpus-per-task 1 --wait ||
   fail "the resubmitted shard or its merge failed"
 logs2=("$tmp"/study/slurm/shard-2-*.out)
 [[ ${#logs2[@]} -eq 2 ]] || fail "expected the logs of shard 2's two tasks, found ${#logs2[@]}"

@@ -64,6 +64,41 @@ TEST(BenchSuites, NamedSuitesCoverThePaperStudies) {
   EXPECT_NE(bad.error().message.find("bogus"), std::string::npos);
 }
 
+// The paper suite: the convergence figure with all six planners (the paper's legend), the
+// breakdown's runs with motion and then simulated (Wrap's own measures), 60 s for them; the smoke
+// suite has a run of every study.
+TEST(BenchSuites, PaperSuiteHasEveryPlannerConvergingAndSimulatedBreakdowns) {
+  BenchOptions o = TinyOptions();
+  o.runs = 1;
+  o.time_limit_s.reset();
+  o.suite = "paper";
+  auto paper = MakeSuite(o);
+  ASSERT_TRUE(paper.has_value());
+  std::set<std::string> converging, simulated;
+  for (const RunSpec& s : *paper) {
+    if (s.optimize) {
+      EXPECT_EQ(s.group, "convergence");
+      converging.insert(s.planner);
+    }
+    if (s.group == "breakdown") {
+      EXPECT_TRUE(s.motion && s.sim) << s.Key();
+      EXPECT_EQ(s.time_limit_s, 60.0);
+      simulated.insert(s.project.name);
+    }
+    if (!s.motion) EXPECT_EQ(s.time_limit_s, 30.0) << s.Key();
+  }
+  EXPECT_EQ(converging,
+            (std::set<std::string>{"optimistic", "wrap", "flat", "counting", "exact", "fine"}));
+  EXPECT_EQ(simulated, (std::set<std::string>{"cross", "stool", "chair"}));
+  o.suite = "smoke";
+  auto smoke = MakeSuite(o);
+  ASSERT_TRUE(smoke.has_value());
+  std::set<std::string> groups;
+  for (const RunSpec& s : *smoke) groups.insert(s.group);
+  EXPECT_EQ(groups, (std::set<std::string>{"comparison", "ablation", "scaling_robots",
+                                           "scaling_parts", "convergence"}));
+}
+
 TEST(BenchDerivedProjects, FewerRobotsAndPrefixesAreValidProjects) {
   TempDir tmp;
   const fs::path r2 = tmp.path() / "projects" / "cross_r2.json";
