@@ -12,7 +12,7 @@
 #   scripts/dev.sh cluster-test install (with Slurm and munge), build `wrap`, and run the Slurm
 #                               test (scripts/slurm/cluster_test.sh: a single-node Slurm of its
 #                               own runs a small suite as a job array, a shard is cancelled and
-#                               resumed, the merge is checked; as root; about 1-2 minutes)
+#                               resumed, the merge is checked; as root; about 1-3 minutes)
 #   scripts/dev.sh sanitize-ci  the part of `sanitize` that CI runs: no UI, only the suites in
 #                               SANITIZE_CI_SUITES below (core, model, geometry, robot,
 #                               collision with URDF import, the fuzz regression and seed replay)
