@@ -1,6 +1,7 @@
 // `wrap bench merge`: shard folders into one report, after checking that they belong together
 // (one revision, one setting per suite, every shard once and finished); the report header's facts.
 #include <algorithm>
+#include <cstdlib>
 #include <map>
 #include <set>
 
@@ -98,6 +99,35 @@ Verdict Check(const std::vector<Entry>& entries) {
   return v;
 }
 
+// Many sessions (a cluster study) in one line: the range of the 1-minute load averages at the
+// sessions' starts and ends.
+std::string LoadRange(const std::vector<ShardRecord>& records) {
+  double lo = 1e9, hi = -1.0, end_lo = 1e9, end_hi = -1.0;
+  int sessions = 0, stopped = 0;
+  std::set<std::string> hosts;
+  for (const ShardRecord& r : records) {
+    for (const Session& s : r.sessions) {
+      ++sessions;
+      hosts.insert(s.host);
+      const double a = std::atof(s.load_start.c_str());
+      lo = std::min(lo, a);
+      hi = std::max(hi, a);
+      if (s.end.empty()) {
+        ++stopped;
+        continue;
+      }
+      const double b = std::atof(s.load_end.c_str());
+      end_lo = std::min(end_lo, b);
+      end_hi = std::max(end_hi, b);
+    }
+  }
+  std::string text = std::to_string(sessions) + " sessions on " + std::to_string(hosts.size()) +
+                     " host(s), 1-minute load " + Num(lo) + " to " + Num(hi) + " at their starts";
+  if (end_hi >= 0.0) text += ", " + Num(end_lo) + " to " + Num(end_hi) + " at their ends";
+  if (stopped > 0) text += ", " + std::to_string(stopped) + " stopped before their end";
+  return text + " (each session's in meta.json)";
+}
+
 }  // namespace
 
 RunInfo ReportInfo(const std::vector<ShardRecord>& records) {
@@ -122,6 +152,7 @@ RunInfo ReportInfo(const std::vector<ShardRecord>& records) {
   info.machine = machines.empty() ? "unknown" : Join({machines.begin(), machines.end()}, "; ");
   info.commit = Join({revisions.begin(), revisions.end()}, "; ");
   info.load = loads.empty() ? "unknown" : Join(loads, "; ");
+  if (loads.size() > 4) info.load = LoadRange(records);
   if (!starts.empty()) {
     info.date = *starts.begin();
     const std::string last = ends.empty() ? "" : *ends.rbegin();

@@ -204,6 +204,17 @@ TEST(BenchMerge, MergesTheShardsOfOneStudy) {
   EXPECT_EQ(meta->shards.size(), 2u);
   // A merged folder merges again (e.g. with another suite's shards), into another folder.
   EXPECT_TRUE(Merge({tmp.path() / "m"}, tmp.path() / "m2").has_value());
+  // Each session's load is in the header; many (a cluster's) as their range.
+  EXPECT_NE(Slurp(tmp.path() / "m" / "report.md").find("shard 2/2 of suite 'tiny' on "),
+            std::string::npos);
+  BenchOptions resume = FakeOptions(tmp.path(), 0.0);
+  resume.shard_index = 2;
+  resume.shard_count = 2;
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(RunSuite(Tiny(resume), resume, s.b).has_value());
+  ASSERT_TRUE(Merge({s.a, s.b}, tmp.path() / "m").has_value());
+  EXPECT_NE(Slurp(tmp.path() / "m" / "report.md").find("5 sessions on 1 host(s), 1-minute load "),
+            std::string::npos)
+      << Slurp(tmp.path() / "m" / "report.md").substr(0, 800);
   // Never into one of its inputs, nor into a shard's folder.
   auto self = Merge({s.a, s.b}, s.a);
   ASSERT_FALSE(self.has_value());
