@@ -47,6 +47,7 @@ struct Session {
   std::string load_start;  ///< Load averages (1, 5, 15 min) at the start.
   std::string load_end;    ///< ... and at the end; empty when killed.
   std::string slurm_job;   ///< SLURM_JOB_ID (and array job and task), or empty.
+  bool unlocked = false;   ///< The folder's file system refused the lock (FolderLock::held).
   int runs_done = 0;       ///< Runs with results when the session ended.
 };
 
