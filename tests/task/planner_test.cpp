@@ -261,6 +261,64 @@ TEST(PlannerInfeasible, VacuumOnlyTransverseForceNamesTheStep) {
       << run.plan->stats.failure;
   EXPECT_NE(run.plan->stats.failure.find("mating wrench"), std::string::npos)
       << run.plan->stats.failure;
+  // The same as data: the task stage, the step, the check, the moved input, the cell.
+  ASSERT_TRUE(run.plan->stats.failure_detail.has_value());
+  const PlanFailure& f = *run.plan->stats.failure_detail;
+  EXPECT_EQ(f.stage, "task");
+  EXPECT_EQ(f.text, run.plan->stats.failure);
+  ASSERT_GE(f.step, 0);
+  ASSERT_LT(f.step, static_cast<int>(run.plan->nodes.size()));
+  EXPECT_EQ(run.plan->nodes[f.step], "seat+leg1");
+  ASSERT_EQ(f.cases.size(), 1u);
+  EXPECT_EQ(f.cases[0].check, "wrench (assembly)");
+  EXPECT_NE(f.text.find(f.cases[0].text), std::string::npos) << "the CLI's words";
+  ASSERT_GE(f.cases[0].object, 0);
+  EXPECT_EQ(run.plan->nodes[f.cases[0].object], project.steps[0].mating.moved);
+  EXPECT_EQ(f.start.q.size(), project.robots.size()) << "every robot's joints";
+  EXPECT_EQ(f.start.X_WP.size(), project.parts.size()) << "every part's pose";
+}
+
+// A part out of every robot's reach: the planner's report names the reach check first (the
+// blocker), and each case says what it tried: the object where it rests, the robot, the grasp.
+TEST(PlannerInfeasible, AnUnreachablePartIsNamedWithItsGraspAndRobot) {
+  const fs::path file = ProjectFile("half_stool");
+  const LoadedProject lp = LoadProject(file);
+  ASSERT_TRUE(lp.ok());
+  Project project = *lp.project;
+  // The second leg to a far corner of the table.
+  Part& leg = project.parts.back();
+  const Vec3 corner(project.table.center_xy.x() + 0.5 * project.table.size.x() - 0.05,
+                    project.table.center_xy.y() - 0.5 * project.table.size.y() + 0.05,
+                    leg.initial_pose.xyz.z());
+  leg.initial_pose.xyz = corner;
+  const ProjectCheck check = ValidateProject(project, file);
+  ASSERT_FALSE(check.diagnostics.has_errors());
+  const PlanRun run = PlanAndValidate(project, check, file, 0, 60.0);
+  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
+  if (run.plan->stats.solved) GTEST_SKIP() << "some robot reaches the corner after all";
+  ASSERT_TRUE(run.plan->stats.failure_detail.has_value()) << run.plan->stats.failure;
+  const PlanFailure& f = *run.plan->stats.failure_detail;
+  EXPECT_EQ(f.stage, "task");
+  EXPECT_EQ(f.text, run.plan->stats.failure);
+  ASSERT_FALSE(f.cases.empty()) << f.text;
+  for (size_t i = 1; i < f.cases.size(); ++i) {
+    EXPECT_GE(f.cases[i - 1].count, f.cases[i].count) << "blocker first";
+  }
+  for (const FailureCase& c : f.cases) {
+    EXPECT_NE(f.text.find(c.check), std::string::npos) << c.check << " in " << f.text;
+    EXPECT_EQ(c.scene.X_WP.size(), project.parts.size());
+  }
+  bool named = false;
+  for (const FailureCase& c : f.cases) {
+    if (c.object >= 0 && run.plan->nodes[c.object] == leg.name && c.robot >= 0 &&
+        c.grasp_part >= 0 && c.X_WA) {
+      named = true;
+      // The object is shown where it was tried.
+      const Iso3 X_WP = c.scene.X_WP[project.parts.size() - 1];
+      EXPECT_LT((X_WP.translation() - c.X_WA->translation()).norm(), 0.5);
+    }
+  }
+  EXPECT_TRUE(named) << "some case names the leg, a robot and a grasp: " << f.text;
 }
 
 // Without the wrench model the same project plans (the failure above is the wrench's).
