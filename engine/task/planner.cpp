@@ -244,7 +244,7 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
       stopped = r.stopped;
       out_of_memory = r.out_of_memory;
       failure = words + " was being planned; checks that failed most: " + r.failure;
-      detail = MilestoneFailure(k, flat ? -1 : order[k], r);
+      detail = MilestoneFailure(flat ? -1 : k, flat ? -1 : order[k], r);
       if (out_of_memory) {
         failure = "out of memory (the search held more than the " +
                   std::to_string(options.memory_limit_mb) + " MiB limit) while " + failure;

@@ -148,8 +148,13 @@ FailureCase TaskSearch::Case(Gate gate, const FailureScene& start) const {
 }
 
 std::vector<FailureCase> TaskSearch::Cases(const FailureScene& start) const {
+  // The gates Summary names (its words are the report's), most failures first.
+  constexpr int kReported = 3;
   std::vector<FailureCase> cases;
-  for (Gate g : tally_.Order()) cases.push_back(Case(g, start));
+  for (Gate g : tally_.Order()) {
+    if (static_cast<int>(cases.size()) == kReported) break;
+    cases.push_back(Case(g, start));
+  }
   return cases;
 }
 
