@@ -178,7 +178,8 @@ void App::ChooseQuality() {
 /// The interactive loop's pacing, so that the window leaves the CPU to the planner: while
 /// nothing changes (no run, no playback, no drag, no edit waiting for the recovery file or the
 /// live validation) it sleeps until the next input, after drawing a few frames past the last one
-/// (ImGui settles hover and focus); while something moves it draws at most 30 frames per second.
+/// that changed (ImGui settles hover, focus and popups); while something moves it draws at most
+/// 30 frames per second.
 void App::Pace() {
   const bool moving = s_.job.running() || s_.playback.playing || ImGui::IsAnyItemActive() ||
                       s_.validation.pending() ||
@@ -198,6 +199,16 @@ void App::Pace() {
                io.DisplaySize.y != last_size_.y;
   for (bool down : io.KeysDown) input = input || down;
   last_size_ = io.DisplaySize;
+  // A frame that drew other shapes than the one before (a popup opening after a click, a panel
+  // filled by a finished check) is followed by more: the window sleeps on a settled picture.
+  std::size_t shapes = 0;
+  if (const ImDrawData* dd = ImGui::GetDrawData()) {
+    shapes = static_cast<std::size_t>(dd->TotalVtxCount) * 31 +
+             static_cast<std::size_t>(dd->TotalIdxCount) * 7 +
+             static_cast<std::size_t>(dd->CmdListsCount);
+  }
+  if (shapes != last_shapes_) input = true;
+  last_shapes_ = shapes;
   if (input) settle_frames_ = 0;
   if (++settle_frames_ < 3) return;
   win_.WaitEvents(2.0);      // and at least every 2 s

@@ -109,8 +109,12 @@ bool App::FailureState(SceneState& state, std::vector<SceneArrow>& arrows,
     }
     return -1;
   };
-  if (c.robot >= 0 && c.robot < static_cast<int>(planned.robots.size())) {
-    const int r = robot_index(planned.robots[c.robot].name);
+  // The robot of the check; for a motion segment, every robot it moves.
+  std::vector<int> blamed = f.stage == "motion" ? f.robots : std::vector<int>{};
+  if (c.robot >= 0) blamed.push_back(c.robot);
+  for (int k : blamed) {
+    if (k < 0 || k >= static_cast<int>(planned.robots.size())) continue;
+    const int r = robot_index(planned.robots[k].name);
     if (r >= 0) highlights.push_back({SceneHighlight::Kind::kRobot, r, kBlame});
   }
   if (c.object >= 0 && c.object < static_cast<int>(rf.node_parts.size())) {

@@ -122,7 +122,9 @@ void PlannerPanel::Draw(AppState& app, const PanelRect& r) {
       std::snprintf(t, sizeof t, " %.1f s", end - st.start_s);
       trail += (i ? " > " : "") + st.name + t;
     }
-    ImGui::TextDisabled("%s", trail.c_str());
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+    ImGui::TextWrapped("%s", trail.c_str());
+    ImGui::PopStyleColor();
     const float f = prog.fraction >= 0 ? static_cast<float>(prog.fraction)
                                        : static_cast<float>(std::fmod(prog.elapsed_s, 1.0));
     ImGui::ProgressBar(f, ImVec2(-1, 0), (prog.stage + ": " + prog.message).c_str());
