@@ -1,6 +1,7 @@
 #include "gui/app.h"
 
 #include <imgui.h>
+#include <imgui_internal.h>
 
 #include <algorithm>
 #include <chrono>
@@ -200,18 +201,24 @@ void App::Pace() {
   for (bool down : io.KeysDown) input = input || down;
   last_size_ = io.DisplaySize;
   // A frame that drew other shapes than the one before (a popup opening after a click, a panel
-  // filled by a finished check) is followed by more: the window sleeps on a settled picture.
+  // filled by a finished check) is followed by more, for a while after the last input: the
+  // window sleeps on a settled picture. The status bar (its frame rate) is left out.
   std::size_t shapes = 0;
   if (const ImDrawData* dd = ImGui::GetDrawData()) {
     shapes = static_cast<std::size_t>(dd->TotalVtxCount) * 31 +
              static_cast<std::size_t>(dd->TotalIdxCount) * 7 +
              static_cast<std::size_t>(dd->CmdListsCount);
+    if (const ImGuiWindow* status = ImGui::FindWindowByName("##status")) {
+      shapes -= static_cast<std::size_t>(status->DrawList->VtxBuffer.Size) * 31 +
+                static_cast<std::size_t>(status->DrawList->IdxBuffer.Size) * 7;
+    }
   }
-  if (shapes != last_shapes_) input = true;
+  if (input) frames_since_input_ = 0;
+  if (shapes != last_shapes_ && ++frames_since_input_ < 20) input = true;
   last_shapes_ = shapes;
   if (input) settle_frames_ = 0;
   if (++settle_frames_ < 3) return;
-  win_.WaitEvents(2.0);      // and at least every 2 s
+  win_.WaitEvents(10.0);     // and at least every 10 s (each wake draws a frame)
   last_time_ = win_.time();  // a wait is not a slow frame
 }
 

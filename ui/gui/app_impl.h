@@ -121,6 +121,7 @@ class App {
   int settle_frames_ = 0;      // frames drawn since the last input while nothing moves
   ImVec2 last_size_{0.0f, 0.0f};
   std::size_t last_shapes_ = 0;  // what the last frame drew, in short (see Pace)
+  int frames_since_input_ = 0;   // frames drawn since the last input
   bool last_frame_fine_ = true;
   bool autosave_ = false;
   unsigned long autosave_revision_ = 0;
