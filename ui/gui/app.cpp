@@ -249,6 +249,7 @@ void App::TakeRun() {
               ", cost " + std::to_string(s_.plan->stats.cost));
   }
   s_.showing_case = -1;
+  s_.run_warnings = prog.warnings;
   if (prog.state == JobState::kSolved || prog.state == JobState::kCancelled) {
     s_.run_failure.reset();
     if (prog.state == JobState::kCancelled) s_.Notify("Planner: cancelled");
@@ -302,7 +303,9 @@ void App::StatusBar(const PanelRect& r) {
   }
   // Problems: a click brings the Problems tab to the front.
   const ValidationResult v = s_.validation.result();
-  const int errors = v.diagnostics.error_count(), warnings = v.diagnostics.warning_count();
+  const int errors = v.diagnostics.error_count();
+  const int warnings =
+      v.diagnostics.warning_count() + static_cast<int>(s_.run_warnings.size());
   if (errors + warnings > 0 || s_.run_failure) {
     ImGui::SameLine();
     ImGui::TextDisabled("|");
@@ -351,6 +354,160 @@ void App::UpdateTitle() {
   }
 }
 
+namespace {
+
+/// --screenshot (with --run-plan, --at): plans while frames draw, then saves the window.
+int RunScreenshot(App& app, const GuiOptions& options, std::ostream& out, std::ostream& err) {
+  AppState& s = app.state();
+  int code = 0;
+  if (options.run_plan) {
+    PlannerRequest q;
+    q.time_limit_s = s.doc.project().planner.time_limit_s;
+    q.seed = s.doc.project().planner.seed;
+    s.job.Start(s.doc.project(), s.doc.ResolvePath(), q);
+    // Frames keep drawing while the worker plans (the window stays responsive).
+    int frames = 0;
+    const auto start = std::chrono::steady_clock::now();
+    while (s.job.running()) {
+      app.Frame(nullptr);
+      ++frames;
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    app.TakeRun();
+    const JobProgress prog = s.job.progress();
+    out << "Planner " << ToString(prog.state) << " in " << seconds << " s; the window drew "
+        << frames << " frames meanwhile (" << (seconds > 0 ? frames / seconds : 0.0)
+        << " per second; median of the last " << s.frames.size() << ": " << s.frames.MedianFps()
+        << " fps, drawing " << (s.viewport.quality() == DrawQuality::kFast ? "fast" : "fine")
+        << ")\n";
+    if (prog.state != JobState::kSolved) {
+      // The same words as `wrap plan`, and each failed check on its own line, blocker first.
+      err << "wrap: planner: " << ToString(prog.state) << "\n";
+      if (s.run_failure) {
+        err << s.run_failure->headline << "\n";
+        if (s.run_failure->failure) {
+          for (const FailureCase& c : s.run_failure->failure->cases) err << "  " << c.text << "\n";
+        }
+      }
+      code = 1;
+    }
+  }
+  if (options.at) s.playback.t = std::clamp(*options.at, 0.0, s.Duration());
+  for (int i = 0; i < 3; ++i) app.Frame(nullptr);
+  render::Image image;
+  app.Frame(&image);
+  const int written = WriteScreenshot(image, options.screenshot, out, err);
+  return written != 0 ? written : code;
+}
+
+/// `measure`: frames drawn back to back (no pacing, no vsync: what one frame costs on this GL)
+/// for `seconds`, orbiting the camera or playing the plan; prints the frame rate.
+void Measure(App& app, const std::string& what, double seconds, std::ostream& out) {
+  AppState& s = app.state();
+  std::vector<double> frame_s;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto last = t0;
+  if (what == "play") s.playback.playing = true;
+  bool fast = false;
+  while (std::chrono::duration<double>(last - t0).count() < seconds) {
+    if (what == "orbit") s.viewport.Orbit(0.004, 0.0);
+    app.Frame(nullptr);
+    fast = fast || s.viewport.quality() == DrawQuality::kFast;
+    const auto now = std::chrono::steady_clock::now();
+    frame_s.push_back(std::chrono::duration<double>(now - last).count());
+    last = now;
+  }
+  if (what == "play") s.playback.playing = false;
+  std::vector<double> sorted = frame_s;
+  std::sort(sorted.begin(), sorted.end());
+  const double total = std::chrono::duration<double>(last - t0).count();
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "measure %s: %zu frames in %.1f s: %.1f fps (median frame %.1f ms, 90th "
+                "percentile %.1f ms; drawing %s%s)",
+                what.c_str(), frame_s.size(), total, static_cast<double>(frame_s.size()) / total,
+                1000.0 * sorted[sorted.size() / 2], 1000.0 * sorted[sorted.size() * 9 / 10],
+                fast ? "fast" : "fine", s.job.running() ? ", planner running" : "");
+  out << buf << "\n";
+}
+
+/// What the frame loop does for one script line after the line ran: New and Open, waits,
+/// measurements, the checks of what the frame drew, screenshots. 0, or the exit code.
+int AfterScriptLine(App& app, const ScriptLine& line, Result<ScriptEffect>& effect,
+                    const GuiOptions& options, std::ostream& out, std::ostream& err) {
+  AppState& s = app.state();
+  if (effect && effect->new_document) app.NewDocument();
+  if (effect && !effect->open.empty() && !app.Open(effect->open)) {
+    effect = std::unexpected(Error{ErrorCode::kInvalidInput, "script line " +
+                                                                 std::to_string(line.number) +
+                                                                 ": " + s.messages.back()});
+  }
+  if (!effect) {
+    err << options.script << ": " << effect.error().message << "\n";
+    return 1;
+  }
+  if (effect->autosave) app.set_autosave(true);
+  if (effect->wait_for_planner) {
+    while (s.job.running()) app.Frame(nullptr);
+    app.TakeRun();
+  }
+  if (effect->wait_for_validation) {
+    // Frames draw while the worker checks (bounded: a check has no cancel point, but ends).
+    while (s.validation.checked_revision() != s.doc.revision()) {
+      s.validation.Update(s.doc.project(), s.doc.revision(), s.doc.ResolvePath(), 0.0, true);
+      app.Frame(nullptr);
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+  if (!effect->measure.empty()) Measure(app, effect->measure, effect->measure_s, out);
+  if (effect->sleep_s > 0) {
+    const auto until =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(effect->sleep_s);
+    while (std::chrono::steady_clock::now() < until) app.Frame(nullptr);
+  }
+  app.Frame(nullptr);
+  if (effect->check) {
+    // Checks that read what the frame drew (the canvas's marks, the viewport's state).
+    if (auto checked = effect->check(s); !checked) {
+      err << options.script << ": script line " << line.number << ": "
+          << checked.error().message << "\n";
+      return 1;
+    }
+  }
+  if (!effect->screenshot.empty()) {
+    render::Image image;
+    app.Frame(&image);
+    if (WriteScreenshot(image, effect->screenshot, out, err) != 0) return 2;
+  }
+  return 0;
+}
+
+/// --script: one line per frame, then the optional --screenshot.
+int RunScript(App& app, const std::vector<ScriptLine>& script, const fs::path& script_dir,
+              const GuiOptions& options, std::ostream& out, std::ostream& err) {
+  AppState& s = app.state();
+  int code = 0;
+  app.Frame(nullptr);
+  for (const ScriptLine& line : script) {
+    auto effect = RunScriptLine(s, line, script_dir);
+    code = AfterScriptLine(app, line, effect, options, out, err);
+    if (code != 0) break;
+    out << "ok " << line.number << ":";
+    for (const std::string& w : line.words) out << " " << w;
+    out << std::endl;  // flushed: a watching process sees each line as it is done
+  }
+  if (!options.screenshot.empty()) {
+    render::Image image;
+    app.Frame(&image);
+    if (const int c = WriteScreenshot(image, options.screenshot, out, err); c != 0) return c;
+  }
+  s.job.Cancel();
+  return code;
+}
+
+}  // namespace
+
 int RunGui(const GuiOptions& options, std::ostream& out, std::ostream& err) {
   // Read the script first: a bad script is bad input before any window opens.
   std::vector<ScriptLine> script;
@@ -385,145 +542,10 @@ int RunGui(const GuiOptions& options, std::ostream& out, std::ostream& err) {
     err << s.messages.back() << "\n";
     return 2;
   }
-
   if (!options.screenshot.empty() && options.script.empty()) {
-    int code = 0;
-    if (options.run_plan) {
-      PlannerRequest q;
-      q.time_limit_s = s.doc.project().planner.time_limit_s;
-      q.seed = s.doc.project().planner.seed;
-      s.job.Start(s.doc.project(), s.doc.ResolvePath(), q);
-      // Frames keep drawing while the worker plans (the window stays responsive).
-      int frames = 0;
-      const auto start = std::chrono::steady_clock::now();
-      while (s.job.running()) {
-        app.Frame(nullptr);
-        ++frames;
-      }
-      const double seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      app.TakeRun();
-      const JobProgress prog = s.job.progress();
-      out << "Planner " << ToString(prog.state) << " in " << seconds << " s; the window drew "
-          << frames << " frames meanwhile (" << (seconds > 0 ? frames / seconds : 0.0)
-          << " per second; median of the last " << s.frames.size() << ": "
-          << s.frames.MedianFps() << " fps, drawing "
-          << (s.viewport.quality() == DrawQuality::kFast ? "fast" : "fine") << ")\n";
-      if (prog.state != JobState::kSolved) {
-        // The same words as `wrap plan`, and each failed check on its own line, blocker first.
-        err << "wrap: planner: " << ToString(prog.state) << "\n";
-        if (s.run_failure) {
-          err << s.run_failure->headline << "\n";
-          if (s.run_failure->failure) {
-            for (const FailureCase& c : s.run_failure->failure->cases) {
-              err << "  " << c.text << "\n";
-            }
-          }
-        }
-        code = 1;
-      }
-    }
-    if (options.at) s.playback.t = std::clamp(*options.at, 0.0, s.Duration());
-    for (int i = 0; i < 3; ++i) app.Frame(nullptr);
-    render::Image image;
-    app.Frame(&image);
-    const int written = WriteScreenshot(image, options.screenshot, out, err);
-    return written != 0 ? written : code;
+    return RunScreenshot(app, options, out, err);
   }
-
-  if (!script.empty()) {
-    int code = 0;
-    app.Frame(nullptr);
-    for (const ScriptLine& line : script) {
-      auto effect = RunScriptLine(s, line, script_dir);
-      if (effect && effect->new_document) app.NewDocument();
-      if (effect && !effect->open.empty() && !app.Open(effect->open)) {
-        effect = std::unexpected(Error{ErrorCode::kInvalidInput,
-                                       "script line " + std::to_string(line.number) + ": " +
-                                           s.messages.back()});
-      }
-      if (!effect) {
-        err << options.script << ": " << effect.error().message << "\n";
-        code = 1;
-        break;
-      }
-      if (effect->autosave) app.set_autosave(true);
-      if (effect->wait_for_planner) {
-        while (s.job.running()) app.Frame(nullptr);
-        app.TakeRun();
-      }
-      if (effect->wait_for_validation) {
-        // Frames draw while the worker checks (bounded: a check has no cancel point, but ends).
-        while (s.validation.checked_revision() != s.doc.revision()) {
-          s.validation.Update(s.doc.project(), s.doc.revision(), s.doc.ResolvePath(), 0.0, true);
-          app.Frame(nullptr);
-          std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        }
-      }
-      if (!effect->measure.empty()) {
-        // Frames drawn back to back (no pacing, no vsync): what one frame costs on this GL.
-        std::vector<double> frame_s;
-        const auto t0 = std::chrono::steady_clock::now();
-        auto last = t0;
-        if (effect->measure == "play") s.playback.playing = true;
-        bool fast = false;
-        while (std::chrono::duration<double>(last - t0).count() < effect->measure_s) {
-          if (effect->measure == "orbit") s.viewport.Orbit(0.004, 0.0);
-          app.Frame(nullptr);
-          fast = fast || s.viewport.quality() == DrawQuality::kFast;
-          const auto now = std::chrono::steady_clock::now();
-          frame_s.push_back(std::chrono::duration<double>(now - last).count());
-          last = now;
-        }
-        if (effect->measure == "play") s.playback.playing = false;
-        std::vector<double> sorted = frame_s;
-        std::sort(sorted.begin(), sorted.end());
-        const double total = std::chrono::duration<double>(last - t0).count();
-        char buf[256];
-        std::snprintf(buf, sizeof buf,
-                      "measure %s: %zu frames in %.1f s: %.1f fps (median frame %.1f ms, 90th "
-                      "percentile %.1f ms; drawing %s%s)",
-                      effect->measure.c_str(), frame_s.size(), total, frame_s.size() / total,
-                      1000.0 * sorted[sorted.size() / 2], 1000.0 * sorted[sorted.size() * 9 / 10],
-                      fast ? "fast" : "fine", s.job.running() ? ", planner running" : "");
-        out << buf << "\n";
-      }
-      if (effect->sleep_s > 0) {
-        const auto until = std::chrono::steady_clock::now() +
-                           std::chrono::duration<double>(effect->sleep_s);
-        while (std::chrono::steady_clock::now() < until) app.Frame(nullptr);
-      }
-      app.Frame(nullptr);
-      if (effect->check) {
-        // Checks that read what the frame drew (the canvas's marks, the viewport's state).
-        if (auto checked = effect->check(s); !checked) {
-          err << options.script << ": script line " << line.number << ": "
-              << checked.error().message << "\n";
-          code = 1;
-          break;
-        }
-      }
-      if (!effect->screenshot.empty()) {
-        render::Image image;
-        app.Frame(&image);
-        if (WriteScreenshot(image, effect->screenshot, out, err) != 0) {
-          code = 2;
-          break;
-        }
-      }
-      out << "ok " << line.number << ":";
-      for (const std::string& w : line.words) out << " " << w;
-      out << std::endl;  // flushed: a watching process sees each line as it is done
-    }
-    if (!options.screenshot.empty()) {
-      render::Image image;
-      app.Frame(&image);
-      if (const int c = WriteScreenshot(image, options.screenshot, out, err); c != 0) return c;
-    }
-    s.job.Cancel();
-    return code;
-  }
-
+  if (!script.empty()) return RunScript(app, script, script_dir, options, out, err);
   while (!app.quit()) {
     app.Frame(nullptr);
     app.HandleCloseRequest();

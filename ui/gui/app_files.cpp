@@ -141,6 +141,7 @@ bool App::Open(const fs::path& path) {
   s_.plan.reset();
   s_.plan_project.reset();
   s_.run_failure.reset();
+  s_.run_warnings.clear();
   s_.showing_case = -1;
   s_.playback = {};
   s_.field_errors.clear();
@@ -163,6 +164,7 @@ void App::NewDocument() {
   s_.plan.reset();
   s_.plan_project.reset();
   s_.run_failure.reset();
+  s_.run_warnings.clear();
   s_.showing_case = -1;
   s_.playback = {};
   s_.field_errors.clear();

@@ -100,6 +100,7 @@ struct AppState {
   /// was opened): the plan is current while the document equals it, else out of date.
   std::shared_ptr<const Project> plan_project;
   std::optional<RunFailure> run_failure;   ///< The last run's failure (none after a solve).
+  std::vector<std::string> run_warnings;   ///< The last run's preprocessing warnings.
   int showing_case = -1;  ///< Failure case the viewport shows ("Show"), -1: the cell as it is.
   LiveValidation validation;               ///< Checks the document after each edit.
   /// Out-of-range values typed into fields, by field key (e.g. "mating.seat+leg1.force_N"):

@@ -187,7 +187,11 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
       Finish(JobState::kFailed, "preprocessing: " + pre.error().message, nullptr);
       return;
     }
-    for (const std::string& w : pre->warnings) Log("warning: " + w);
+    for (const std::string& w : pre->warnings) {
+      Log("warning: " + w);
+      std::lock_guard lock(mutex_);
+      progress_.warnings.push_back(w);
+    }
 
     stage("task", "searching for a task plan (" + request.planner + ")");
     PipelineOptions pipeline;

@@ -53,6 +53,7 @@ struct JobProgress {
   std::vector<std::string> log;      ///< Every message so far, oldest first.
   std::vector<JobStage> stages;      ///< The stages entered so far, in order.
   std::string error;                 ///< Why the run failed or found no plan (in words).
+  std::vector<std::string> warnings;  ///< Preprocessing's warnings (as `wrap plan` prints them).
   /// The failure as data when the planner found no plan (the CLI's words in `text`, the checks
   /// that failed with the cell at each); null when it solved, or failed before planning.
   std::shared_ptr<const PlanFailure> failure;

@@ -83,7 +83,9 @@ void SelectEntity(AppState& app, const EntityRef& entity) {
 
 std::string ProblemsPanel::Title(const AppState& app) {
   const ValidationResult v = app.validation.result();
-  const int errors = v.diagnostics.error_count(), warnings = v.diagnostics.warning_count();
+  const int errors = v.diagnostics.error_count();
+  const int warnings =
+      v.diagnostics.warning_count() + static_cast<int>(app.run_warnings.size());
   std::string title = "Problems";
   if (app.run_failure) title += " (no plan";
   if (errors + warnings > 0) {
@@ -141,6 +143,19 @@ void ProblemsPanel::Contents(AppState& app) {
       }
     }
     if (app.showing_case >= 0 && ImGui::SmallButton("Back to the cell")) app.showing_case = -1;
+    ImGui::Separator();
+  }
+
+  // ---- The last run's preprocessing warnings (`wrap plan` prints them too).
+  if (!app.run_warnings.empty()) {
+    ImGui::TextUnformatted("Planner");
+    ImGui::SameLine();
+    ImGui::TextDisabled("warnings of the last run's preprocessing");
+    for (const std::string& w : app.run_warnings) {
+      ImGui::TextColored(kWarning, "warning");
+      ImGui::SameLine();
+      ImGui::TextWrapped("%s", w.c_str());
+    }
     ImGui::Separator();
   }
 

@@ -213,6 +213,7 @@ std::vector<std::string> ProblemLines(const AppState& app) {
       for (const FailureCase& c : app.run_failure->failure->cases) lines.push_back(c.text);
     }
   }
+  for (const std::string& w : app.run_warnings) lines.push_back("warning " + w);
   const ValidationResult v = app.validation.result();
   const Project& checked = v.project ? *v.project : app.doc.project();
   for (const Diagnostic& d : v.diagnostics.items) {
