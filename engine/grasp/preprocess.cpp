@@ -123,9 +123,10 @@ class Lap {
 
  private:
   void Report() const {
-    static constexpr const char* kPhases[] = {"subassemblies",    "convex hulls",
-                                              "stable placements", "table slots (IK over the table)",
-                                              "grasp candidates",  "grasp selection"};
+    static constexpr const char* kPhases[] = {
+        "subassemblies",     "convex hulls",
+        "stable placements", "table slots (IK over the table)",
+        "grasp candidates",  "grasp selection"};
     constexpr int n = static_cast<int>(std::size(kPhases));
     if (done_ >= n) return;
     ctx_.Progress("preprocess", static_cast<double>(done_) / n,

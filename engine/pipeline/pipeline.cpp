@@ -38,7 +38,8 @@ std::uint64_t Signature(const Plan& plan) {
 }
 
 // The motion stage's failure record of `plan`'s motion failure `f` (the words: `words`).
-PlanFailure MotionFailureRecord(const Plan& plan, const MotionFailure& f, const std::string& words) {
+PlanFailure MotionFailureRecord(const Plan& plan, const MotionFailure& f,
+                                const std::string& words) {
   PlanFailure d;
   d.stage = "motion";
   d.action = f.action;
@@ -153,10 +154,10 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
       sub.set_deadline(ctx.deadline());
       sub.set_stop_token(ctx.stop_token());
       ++made;
-      sub.set_progress([&ctx, n = made](const std::string& stage, double fraction,
-                                        const std::string& message) {
-        ctx.Progress(stage, fraction, "task plan " + std::to_string(n) + ": " + message);
-      });
+      sub.set_progress(
+          [&ctx, n = made](const std::string& stage, double fraction, const std::string& message) {
+            ctx.Progress(stage, fraction, "task plan " + std::to_string(n) + ": " + message);
+          });
       auto next = PlanTask(project, check, pre, task, sub);
       if (!next) {
         if (next.error().code == ErrorCode::kCancelled) return std::unexpected(next.error());

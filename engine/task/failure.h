@@ -27,11 +27,11 @@ struct FailureScene {
 /// One kind of check that failed (a gate of the task planner, or a motion segment), with the
 /// first example of it.
 struct FailureCase {
-  std::string check;    ///< The check in words: "IK", "collision", "wrench (assembly)", ...
-  long long count = 0;  ///< How many distinct questions failed it (1 for motion).
-  std::string text;     ///< The CLI's words for it, e.g. "IK failed 40x (e.g. ...)".
-  std::string example;  ///< The example alone, in words.
-  int object = -1;      ///< DAG node id of the object tried (-1: none named).
+  std::string check;         ///< The check in words: "IK", "collision", "wrench (assembly)", ...
+  long long count = 0;       ///< How many distinct questions failed it (1 for motion).
+  std::string text;          ///< The CLI's words for it, e.g. "IK failed 40x (e.g. ...)".
+  std::string example;       ///< The example alone, in words.
+  int object = -1;           ///< DAG node id of the object tried (-1: none named).
   std::optional<Iso3> X_WA;  ///< Where the object was tried (its assembly frame in the world).
   int robot = -1;            ///< The robot that could not reach, or whose gripper hit.
   int grasp_part = -1;       ///< Part the tried grasp is on (-1: no grasp named).
@@ -44,11 +44,11 @@ struct FailureCase {
 
 /// Why a run found no plan.
 struct PlanFailure {
-  std::string stage;   ///< "task" or "motion".
-  std::string text;    ///< The whole reason, the CLI's words (= PlanStats::failure).
-  int milestone = -1;  ///< Task: index of the milestone that failed (planning order).
-  int step = -1;       ///< Task: DAG node id of its step; motion: the failing action's step.
-  int action = -1;     ///< Motion: index of the action whose segment failed.
+  std::string stage;        ///< "task" or "motion".
+  std::string text;         ///< The whole reason, the CLI's words (= PlanStats::failure).
+  int milestone = -1;       ///< Task: index of the milestone that failed (planning order).
+  int step = -1;            ///< Task: DAG node id of its step; motion: the failing action's step.
+  int action = -1;          ///< Motion: index of the action whose segment failed.
   std::string segment;      ///< Motion: the segment's kind ("free", "approach", ...).
   std::vector<int> robots;  ///< Motion: the robots of the segment.
   /// The cell where the failing stage started: task, the milestone's start (robots at home or

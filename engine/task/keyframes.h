@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "robot/cell.h"
-#include "task/planner.h"
 #include "task/failure.h"
+#include "task/planner.h"
 #include "task/state.h"
 #include "task/world.h"
 #include "task/wrench_model.h"

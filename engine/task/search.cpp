@@ -60,7 +60,7 @@ bool TaskSearch::Recall(std::uint64_t key, const CheapAnswer& answer) {
 void TaskSearch::Remember(std::uint64_t key, bool ok) {
   tallied_.insert(key);
   cheap_[key] = ok ? CheapAnswer{}
-                  : CheapAnswer{false, tally_.last_gate, tally_.last_message, tally_.last_subject};
+                   : CheapAnswer{false, tally_.last_gate, tally_.last_message, tally_.last_subject};
 }
 
 std::string GateTally::Summary(int max_gates) const {
@@ -498,8 +498,8 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
       through.hit_table = true;
       tally_.Add(Gate::kTable,
                  "'" + world_.tree->nodes[m.moved].name +
-                     "' would go through the table to reach '" +
-                     world_.tree->nodes[m.base].name + "' resting as it is",
+                     "' would go through the table to reach '" + world_.tree->nodes[m.base].name +
+                     "' resting as it is",
                  through);
     }
     if (ok) {

@@ -28,8 +28,8 @@ FailureScene TaskSearch::SceneOf(const SymState& s, const ContState& c) const {
   FailureScene scene;
   scene.q = c.q;
   scene.X_WP.assign(world_.num_parts, Iso3::Identity());
-  for (int node = 0; node < static_cast<int>(s.loc.size()) && node < static_cast<int>(c.X_WA.size());
-       ++node) {
+  for (int node = 0;
+       node < static_cast<int>(s.loc.size()) && node < static_cast<int>(c.X_WA.size()); ++node) {
     if (s.loc[node] == kInactive) continue;
     for (int p : world_.tree->nodes[node].parts) scene.X_WP[p] = c.X_WA[node] * world_.X_AP[p];
   }

@@ -478,9 +478,8 @@ TEST(GuiCli, NewAndEditsNeverShowAStalePicture) {
                                           << "expect-viewport empty\n"
                                           << "screenshot new.png\n";
   fs::create_directories(dir / "elsewhere");
-  const ProcessRun r =
-      WrapUnderXvfb(dir, "'" + ExampleProject("half_stool").string() +
-                             "' --script stale.wrapscript --size 1400x900");
+  const ProcessRun r = WrapUnderXvfb(dir, "'" + ExampleProject("half_stool").string() +
+                                              "' --script stale.wrapscript --size 1400x900");
   ASSERT_EQ(r.code, 0) << r.output;
   // New: the viewport as without a project (the empty cell), not the half stool's.
   auto empty = render::ReadPng(dir / "empty.png");

@@ -109,7 +109,6 @@ TEST(Timeline, DurationIsTheMakespanOrTheLastKeyframe) {
   EXPECT_EQ(app.Duration(), 12.5);
 }
 
-
 TEST(FrameRate, RecentCountsTheFramesOfTheLastSecond) {
   FrameStats f;
   // A burst of ten quick frames after a long wait reads as ten per second, not hundreds.
@@ -184,8 +183,8 @@ TEST(Fields, RangesRefuseOutOfRangeValuesWithAMessage) {
   EXPECT_NE(RefusedValue(*FindField("limits", "torque_Nm"), -0.1), "");
   EXPECT_EQ(RefusedValue(*FindField("mating", "torque_Nm"), -2.0), "") << "a sense, not a size";
   // Every mating and wrench field has a tooltip.
-  for (const char* name : {"force_N", "torque_Nm", "transverse_fraction", "offset_m",
-                           "approach_m", "axis", "connection_force_N", "connection_torque_Nm"}) {
+  for (const char* name : {"force_N", "torque_Nm", "transverse_fraction", "offset_m", "approach_m",
+                           "axis", "connection_force_N", "connection_torque_Nm"}) {
     ASSERT_NE(FindField("mating", name), nullptr) << name;
     EXPECT_GT(std::string(FindField("mating", name)->help).size(), 20u) << name;
   }

@@ -304,8 +304,7 @@ void App::StatusBar(const PanelRect& r) {
   // Problems: a click brings the Problems tab to the front.
   const ValidationResult v = s_.validation.result();
   const int errors = v.diagnostics.error_count();
-  const int warnings =
-      v.diagnostics.warning_count() + static_cast<int>(s_.run_warnings.size());
+  const int warnings = v.diagnostics.warning_count() + static_cast<int>(s_.run_warnings.size());
   if (errors + warnings > 0 || s_.run_failure) {
     ImGui::SameLine();
     ImGui::TextDisabled("|");
@@ -325,7 +324,8 @@ void App::StatusBar(const PanelRect& r) {
     ImGui::SameLine();
     const float room = ImGui::GetContentRegionAvail().x - 8.0f;
     std::string line = s_.messages.back();
-    if (const auto nl = line.find('\n'); nl != std::string::npos) line = line.substr(0, nl) + " ...";
+    if (const auto nl = line.find('\n'); nl != std::string::npos)
+      line = line.substr(0, nl) + " ...";
     while (line.size() > 4 && ImGui::CalcTextSize(line.c_str()).x > room) {
       line = line.substr(0, line.size() - 5) + "...";
     }
@@ -345,8 +345,8 @@ void App::StatusBar(const PanelRect& r) {
 }
 
 void App::UpdateTitle() {
-  std::string title = "Wrap - " + (s_.doc.project().name.empty() ? std::string("untitled")
-                                                                 : s_.doc.project().name);
+  std::string title =
+      "Wrap - " + (s_.doc.project().name.empty() ? std::string("untitled") : s_.doc.project().name);
   if (s_.doc.dirty()) title += " *";
   if (title != title_) {
     win_.SetTitle(title);
@@ -439,9 +439,9 @@ int AfterScriptLine(App& app, const ScriptLine& line, Result<ScriptEffect>& effe
   AppState& s = app.state();
   if (effect && effect->new_document) app.NewDocument();
   if (effect && !effect->open.empty() && !app.Open(effect->open)) {
-    effect = std::unexpected(Error{ErrorCode::kInvalidInput, "script line " +
-                                                                 std::to_string(line.number) +
-                                                                 ": " + s.messages.back()});
+    effect = std::unexpected(
+        Error{ErrorCode::kInvalidInput,
+              "script line " + std::to_string(line.number) + ": " + s.messages.back()});
   }
   if (!effect) {
     err << options.script << ": " << effect.error().message << "\n";
@@ -470,8 +470,8 @@ int AfterScriptLine(App& app, const ScriptLine& line, Result<ScriptEffect>& effe
   if (effect->check) {
     // Checks that read what the frame drew (the canvas's marks, the viewport's state).
     if (auto checked = effect->check(s); !checked) {
-      err << options.script << ": script line " << line.number << ": "
-          << checked.error().message << "\n";
+      err << options.script << ": script line " << line.number << ": " << checked.error().message
+          << "\n";
       return 1;
     }
   }

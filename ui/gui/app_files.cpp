@@ -377,11 +377,11 @@ void App::Popups() {
   } else if (fresh == 2) {
     NewDocument();
   }
-  const int recover = Choice("Recover unsaved edits?", offer_recovery_,
-                             "A recovery file newer than the project was found:\n" +
-                                 s_.doc.RecoveryPath().string() +
-                                 "\n(Wrap was closed without saving, or crashed.)",
-                             "Recover", "Discard it");
+  const int recover =
+      Choice("Recover unsaved edits?", offer_recovery_,
+             "A recovery file newer than the project was found:\n" +
+                 s_.doc.RecoveryPath().string() + "\n(Wrap was closed without saving, or crashed.)",
+             "Recover", "Discard it");
   if (recover == 1) {
     if (auto r = s_.doc.Recover(); !r) s_.Notify("Recovery failed: " + r.error().message);
   } else if (recover == 2) {

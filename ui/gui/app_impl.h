@@ -21,12 +21,13 @@ namespace wrap::gui {
 /// its files of one kind (recognised by their "format" tag), and the recent files. A click on a
 /// file takes its path; a double-click or Enter confirms.
 struct FileDialog {
-  std::string title;       ///< Popup title, e.g. "Open project".
-  std::string action;      ///< Confirm button, e.g. "Open".
-  std::string format_tag;  ///< Files listed: .json files whose start holds this, e.g. "wrap-project".
-  bool save = false;       ///< Saving: a file that exists is flagged as to be replaced.
-  std::string path;        ///< The path field.
-  std::string dir;         ///< Folder listed.
+  std::string title;   ///< Popup title, e.g. "Open project".
+  std::string action;  ///< Confirm button, e.g. "Open".
+  std::string
+      format_tag;     ///< Files listed: .json files whose start holds this, e.g. "wrap-project".
+  bool save = false;  ///< Saving: a file that exists is flagged as to be replaced.
+  std::string path;   ///< The path field.
+  std::string dir;    ///< Folder listed.
   /// Opens the dialog on the next frame, its field at `start_path` (its folder listed).
   void Request(const std::string& start_path);
   /// Draws it while open; true once when confirmed (then `path` holds the file).
@@ -126,8 +127,8 @@ class App {
   bool autosave_ = false;
   unsigned long autosave_revision_ = 0;
   unsigned long autosave_failed_ = ~0UL;
-  unsigned long taken_run_ = 0;  // run_id of the last run whose outcome was taken
-  double last_build_ = -1.0;     // when the viewport's cell was last built [s]
+  unsigned long taken_run_ = 0;       // run_id of the last run whose outcome was taken
+  double last_build_ = -1.0;          // when the viewport's cell was last built [s]
   std::optional<Project> built_key_;  // the project it was built of, initial poses left out
   std::filesystem::path built_file_;  // and the file its paths resolved against
 };

@@ -13,9 +13,9 @@ namespace wrap::gui {
 
 namespace {
 
-constexpr Rgba kBlame = {0.95, 0.12, 0.1, 1.0};   // a robot that could not, bodies that collided
-constexpr Rgba kObject = {1.0, 0.72, 0.1, 1.0};   // the object that was tried
-constexpr Rgba kGrasp = {0.95, 0.3, 0.9, 1.0};    // the grasp that was tried
+constexpr Rgba kBlame = {0.95, 0.12, 0.1, 1.0};  // a robot that could not, bodies that collided
+constexpr Rgba kObject = {1.0, 0.72, 0.1, 1.0};  // the object that was tried
+constexpr Rgba kGrasp = {0.95, 0.3, 0.9, 1.0};   // the grasp that was tried
 
 int IndexOf(const std::vector<std::string>& names, const std::string& name) {
   auto it = std::find(names.begin(), names.end(), name);
@@ -72,8 +72,7 @@ void App::UpdateViewport() {
   s_.viewport.set_arrows(std::move(arrows));
   s_.viewport.set_markers(std::move(markers));
   s_.viewport.set_highlights(std::move(highlights));
-  s_.viewport.set_gripper_tints(failure ? std::vector<std::optional<Rgba>>{}
-                                        : GripperTints(scene));
+  s_.viewport.set_gripper_tints(failure ? std::vector<std::optional<Rgba>>{} : GripperTints(scene));
 }
 
 bool App::FailureState(SceneState& state, std::vector<SceneArrow>& arrows,
@@ -90,8 +89,7 @@ bool App::FailureState(SceneState& state, std::vector<SceneArrow>& arrows,
   const FailureScene& fs = c.scene.X_WP.empty() && c.scene.q.empty() ? f.start : c.scene;
   for (size_t r = 0; r < scene.robots.size(); ++r) {
     for (size_t k = 0; k < planned.robots.size() && k < fs.q.size(); ++k) {
-      if (planned.robots[k].name == scene.robots[r].name &&
-          fs.q[k].size() == state.q[r].size()) {
+      if (planned.robots[k].name == scene.robots[r].name && fs.q[k].size() == state.q[r].size()) {
         state.q[r] = fs.q[k];
       }
     }

@@ -17,10 +17,10 @@
 
 namespace wrap::gui {
 
+using render::DrawQuality;
 using render::SceneArrow;
 using render::SceneHighlight;
 using render::SceneMarker;
-using render::DrawQuality;
 using render::ViewportRenderer;
 
 /// What is selected, shared by the viewport, the DAG canvas and the editors.
@@ -74,9 +74,9 @@ class FrameStats {
 /// changed since).
 struct RunFailure {
   std::string headline;  ///< The CLI's line, e.g. "No plan found in 12.3 s: milestone 2/4 ...".
-  std::shared_ptr<const PlanFailure> failure;  ///< The record (null: the run failed earlier).
-  std::shared_ptr<const Project> project;      ///< The project as planned.
-  std::vector<std::string> nodes;              ///< DAG node names by node id (parts, steps).
+  std::shared_ptr<const PlanFailure> failure;        ///< The record (null: the run failed earlier).
+  std::shared_ptr<const Project> project;            ///< The project as planned.
+  std::vector<std::string> nodes;                    ///< DAG node names by node id (parts, steps).
   std::vector<std::vector<std::string>> node_parts;  ///< Part names of each node.
   /// The step the failure is about (a name of `project`), or "".
   std::string StepName() const;
@@ -99,16 +99,16 @@ struct AppState {
   /// The project the plan was made for (the run's snapshot, or the document when a plan file
   /// was opened): the plan is current while the document equals it, else out of date.
   std::shared_ptr<const Project> plan_project;
-  std::optional<RunFailure> run_failure;   ///< The last run's failure (none after a solve).
-  std::vector<std::string> run_warnings;   ///< The last run's preprocessing warnings.
-  int showing_case = -1;  ///< Failure case the viewport shows ("Show"), -1: the cell as it is.
-  LiveValidation validation;               ///< Checks the document after each edit.
+  std::optional<RunFailure> run_failure;  ///< The last run's failure (none after a solve).
+  std::vector<std::string> run_warnings;  ///< The last run's preprocessing warnings.
+  int showing_case = -1;      ///< Failure case the viewport shows ("Show"), -1: the cell as it is.
+  LiveValidation validation;  ///< Checks the document after each edit.
   /// Out-of-range values typed into fields, by field key (e.g. "mating.seat+leg1.force_N"):
   /// the message shown under the field; cleared by the next valid value.
   std::map<std::string, std::string> field_errors;
-  std::map<std::string, JointVector> jog;  ///< Robot name -> joints set with its sliders.
-  GizmoMode gizmo = GizmoMode::kTranslate; ///< The viewport gizmo's mode.
-  bool focus_problems = false;             ///< Bring the Problems tab to the front once.
+  std::map<std::string, JointVector> jog;   ///< Robot name -> joints set with its sliders.
+  GizmoMode gizmo = GizmoMode::kTranslate;  ///< The viewport gizmo's mode.
+  bool focus_problems = false;              ///< Bring the Problems tab to the front once.
   std::string canvas_marked;  ///< Step the DAG canvas drew as failing in the last frame ("").
   Playback playback;                       ///< Timeline.
   ViewportRenderer viewport;               ///< The cell in the viewport.

@@ -135,8 +135,8 @@ bool RangedDouble(AppState& app, const FieldSpec& spec, const std::string& key, 
                   float speed, const char* format) {
   double v = value;
   // The range bounds the drag; a typed value is not clamped (no AlwaysClamp): it is checked.
-  const bool changed = ImGui::DragScalar(spec.label, ImGuiDataType_Double, &v, speed, &spec.min,
-                                         &spec.max, format);
+  const bool changed =
+      ImGui::DragScalar(spec.label, ImGuiDataType_Double, &v, speed, &spec.min, &spec.max, format);
   Tooltip(spec);
   bool applied = false;
   if (changed) {
@@ -154,8 +154,8 @@ bool RangedDouble(AppState& app, const FieldSpec& spec, const std::string& key, 
 bool RangedVec3(AppState& app, const FieldSpec& spec, const std::string& key, const char* label,
                 Vec3& value, float speed, const char* format) {
   double a[3] = {value.x(), value.y(), value.z()};
-  const bool changed = ImGui::DragScalarN(label, ImGuiDataType_Double, a, 3, speed, &spec.min,
-                                          &spec.max, format);
+  const bool changed =
+      ImGui::DragScalarN(label, ImGuiDataType_Double, a, 3, speed, &spec.min, &spec.max, format);
   Tooltip(spec);
   bool applied = false;
   if (changed) {

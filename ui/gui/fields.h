@@ -13,7 +13,7 @@ namespace wrap::gui {
 
 /// One editable number (or each component of a vector) and what it may hold.
 struct FieldSpec {
-  const char* name;  ///< Field name in the script's `set`, e.g. "force_N".
+  const char* name;   ///< Field name in the script's `set`, e.g. "force_N".
   const char* label;  ///< Label in the editor, e.g. "force [N]".
   double min;         ///< Least value allowed.
   double max;         ///< Largest value allowed.

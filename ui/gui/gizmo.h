@@ -13,10 +13,10 @@ namespace wrap::gui {
 
 /// The viewport's camera as a pinhole projection into a screen rectangle.
 struct ScreenCamera {
-  CameraView view;        ///< MuJoCo free camera (look-at, azimuth, elevation, distance).
-  double fovy_deg = 45;   ///< Vertical field of view [deg].
-  ImVec2 origin{0, 0};    ///< Top-left corner of the viewport [px].
-  ImVec2 size{1, 1};      ///< Its size [px].
+  CameraView view;       ///< MuJoCo free camera (look-at, azimuth, elevation, distance).
+  double fovy_deg = 45;  ///< Vertical field of view [deg].
+  ImVec2 origin{0, 0};   ///< Top-left corner of the viewport [px].
+  ImVec2 size{1, 1};     ///< Its size [px].
   /// The screen point of world point p_W; false when it is behind the camera.
   bool Project(const Vec3& p_W, ImVec2& out) const;
   /// World metres per pixel at the depth of p_W.

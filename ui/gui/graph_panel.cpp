@@ -17,11 +17,11 @@ namespace wrap::gui {
 
 namespace {
 
-constexpr float kNodeH = 26.0f;    // node height (canvas units)
-constexpr float kLabelH = 16.0f;   // room under a step for its "needs inputs" label
-constexpr float kRowGap = 12.0f;   // between nodes of a column
-constexpr float kColGap = 44.0f;   // between columns
-constexpr float kPadX = 16.0f;     // text padding inside a node
+constexpr float kNodeH = 26.0f;   // node height (canvas units)
+constexpr float kLabelH = 16.0f;  // room under a step for its "needs inputs" label
+constexpr float kRowGap = 12.0f;  // between nodes of a column
+constexpr float kColGap = 44.0f;  // between columns
+constexpr float kPadX = 16.0f;    // text padding inside a node
 constexpr float kMinZoom = 0.3f;
 
 const Step* FindStep(const Project& p, const std::string& name) {
@@ -89,7 +89,8 @@ void GraphPanel::AutoLayout(const Project& project) {
   }
   for (const Part& part : project.parts) {
     auto c = consumer.find(part.name);
-    level[part.name] = c == consumer.end() ? 0 : std::max(0, level[project.steps[c->second].name] - 1);
+    level[part.name] =
+        c == consumer.end() ? 0 : std::max(0, level[project.steps[c->second].name] - 1);
   }
   // Within a level, nodes in the order of the steps they feed (inputs of one step together).
   int deepest = 0;
@@ -108,8 +109,9 @@ void GraphPanel::AutoLayout(const Project& project) {
     return c == consumer.end() ? static_cast<int>(project.steps.size()) : c->second;
   };
   for (auto& names : by_level) {
-    std::stable_sort(names.begin(), names.end(),
-                     [&](const std::string& a, const std::string& b) { return order(a) < order(b); });
+    std::stable_sort(names.begin(), names.end(), [&](const std::string& a, const std::string& b) {
+      return order(a) < order(b);
+    });
   }
   // Two layouts: levels as columns (flow left to right) or as rows (top to bottom); the one that
   // shows the whole graph larger in the canvas is kept.
@@ -166,8 +168,8 @@ void GraphPanel::FitToView() {
   const float zy = (canvas_height - 2 * margin) / std::max(1.0f, y1 - y0);
   zoom = std::clamp(std::min(zx, zy), kMinZoom, 1.0f);
   // Centred horizontally when it fits, from the top.
-  scroll.x = margin - x0 * zoom + std::max(0.0f, 0.5f * (canvas_width - 2 * margin -
-                                                          (x1 - x0) * zoom));
+  scroll.x =
+      margin - x0 * zoom + std::max(0.0f, 0.5f * (canvas_width - 2 * margin - (x1 - x0) * zoom));
   scroll.y = margin - y0 * zoom;
   fit_pending = false;
 }
@@ -331,7 +333,9 @@ void GraphPanel::Draw(AppState& app, const PanelRect& r) {
                          : selected ? IM_COL32(255, 220, 90, 255)
                                     : IM_COL32(110, 115, 125, 255);
     dl->AddRect(b, ImVec2(b.x + w, b.y + node_h), border, 4.0f, 0,
-                failed ? 3.0f : selected ? 2.5f : 1.0f);
+                failed     ? 3.0f
+                : selected ? 2.5f
+                           : 1.0f);
     dl->AddText(nullptr, font, ImVec2(b.x + kPadX * zoom, b.y + 0.5f * (node_h - font)),
                 IM_COL32(230, 230, 230, 255), n.c_str());
     dl->AddCircleFilled(port(n), 4.5f * std::max(zoom, 0.6f), IM_COL32(200, 200, 90, 255));
@@ -407,9 +411,10 @@ void GraphPanel::Draw(AppState& app, const PanelRect& r) {
       }
       ImGui::SetTooltip("%s", tip.c_str());
     } else {
-      ImGui::SetTooltip("part '%s' (drag its port, the yellow dot, onto a step to make it an "
-                        "input)",
-                        node_under_mouse.c_str());
+      ImGui::SetTooltip(
+          "part '%s' (drag its port, the yellow dot, onto a step to make it an "
+          "input)",
+          node_under_mouse.c_str());
     }
   }
   if (!hovered_edge_step.empty()) {

@@ -42,9 +42,9 @@ struct PartsPanel {
 };
 
 /// The assembly DAG as a node canvas: parts and steps with their full names, drag from a node's
-/// out port (yellow) onto a step to make an input, right-click an edge to remove it, automatic layout that
-/// keeps every node in view (fit to view; wheel zooms, middle drag pans), hover a step for its
-/// mating; the step where the last run failed is marked red.
+/// out port (yellow) onto a step to make an input, right-click an edge to remove it, automatic
+/// layout that keeps every node in view (fit to view; wheel zooms, middle drag pans), hover a step
+/// for its mating; the step where the last run failed is marked red.
 struct GraphPanel {
   std::map<std::string, ImVec2> pos;   ///< Node positions on the canvas (canvas units).
   std::map<std::string, float> width;  ///< Node widths from their names (canvas units).
@@ -126,12 +126,12 @@ void SelectEntity(AppState& app, const EntityRef& entity);
 /// pan (right or middle), zoom (wheel), click to select a part, shift+drag moves the selected
 /// part on the table, a translate/rotate gizmo on the selected part or robot base; reset view.
 struct ViewportPanel {
-  PanelRect rect;          ///< Where the cell was drawn this frame (window coordinates).
-  ImVec2 press{0, 0};      ///< Where the mouse went down.
+  PanelRect rect;      ///< Where the cell was drawn this frame (window coordinates).
+  ImVec2 press{0, 0};  ///< Where the mouse went down.
   /// What the drag under way does, decided when the mouse went down: a drag that starts with
   /// shift held on a selected part moves it until the button is released, whatever the keys.
   enum class Drag { kNone, kCamera, kMovePart, kGizmo } drag = Drag::kNone;
-  int gizmo_axis = -1;     ///< Gizmo handle being dragged (0-2 move x/y/z, 3-5 turn about x/y/z).
+  int gizmo_axis = -1;  ///< Gizmo handle being dragged (0-2 move x/y/z, 3-5 turn about x/y/z).
   void Draw(AppState& app, const PanelRect& r);
 };
 

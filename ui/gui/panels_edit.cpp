@@ -48,13 +48,13 @@ bool EditPose(const char* id, Pose& pose) {
 bool EditBox(AppState& app, const char* id, const std::string& key, WrenchBox& box,
              bool connection) {
   ImGui::PushID(id);
-  const FieldSpec& force = connection ? *FindField("mating", "connection_force_N")
-                                      : *FindField("limits", "force_N");
-  const FieldSpec& torque = connection ? *FindField("mating", "connection_torque_Nm")
-                                       : *FindField("limits", "torque_Nm");
+  const FieldSpec& force =
+      connection ? *FindField("mating", "connection_force_N") : *FindField("limits", "force_N");
+  const FieldSpec& torque =
+      connection ? *FindField("mating", "connection_torque_Nm") : *FindField("limits", "torque_Nm");
   bool changed = RangedVec3(app, force, key + ".force_N", "force [N]", box.force_N, 0.1f, "%.1f");
-  changed |= RangedVec3(app, torque, key + ".torque_Nm", "torque [N m]", box.torque_Nm, 0.01f,
-                        "%.2f");
+  changed |=
+      RangedVec3(app, torque, key + ".torque_Nm", "torque [N m]", box.torque_Nm, 0.01f, "%.2f");
   ImGui::PopID();
   return changed;
 }
@@ -188,8 +188,8 @@ void PartsPanel::Draw(AppState& app, const PanelRect& r) {
         }
         ImGui::TextDisabled("mesh: %s", part.mesh.c_str());
         bool changed = false;
-        changed |= RangedDouble(app, *FindField("part", "scale"), key + "scale", part.scale, 0.0001f,
-                                "%.4g");
+        changed |= RangedDouble(app, *FindField("part", "scale"), key + "scale", part.scale,
+                                0.0001f, "%.4g");
         bool has_mass = part.mass_kg.has_value();
         if (ImGui::Checkbox("given mass", &has_mass)) {
           part.mass_kg = has_mass ? std::optional<double>(0.1) : std::nullopt;
@@ -272,14 +272,14 @@ void MatingPanel::Draw(AppState& app, const PanelRect& r) {
     float speed;
     const char* format;
   };
-  for (const NumberField& f : {NumberField{"force_N", &m.force_N, 0.1f, "%.1f"},
-                               NumberField{"torque_Nm", &m.torque_Nm, 0.01f, "%.2f"},
-                               NumberField{"transverse_fraction", &m.transverse_fraction, 0.005f,
-                                           "%.3f"},
-                               NumberField{"offset_m", &m.offset_m, 0.0005f, "%.4f"},
-                               NumberField{"approach_m", &m.approach_m, 0.001f, "%.3f"}}) {
-    changed |= RangedDouble(app, *FindField("mating", f.name), key + f.name, *f.value, f.speed,
-                            f.format);
+  for (const NumberField& f :
+       {NumberField{"force_N", &m.force_N, 0.1f, "%.1f"},
+        NumberField{"torque_Nm", &m.torque_Nm, 0.01f, "%.2f"},
+        NumberField{"transverse_fraction", &m.transverse_fraction, 0.005f, "%.3f"},
+        NumberField{"offset_m", &m.offset_m, 0.0005f, "%.4f"},
+        NumberField{"approach_m", &m.approach_m, 0.001f, "%.3f"}}) {
+    changed |=
+        RangedDouble(app, *FindField("mating", f.name), key + f.name, *f.value, f.speed, f.format);
   }
   ImGui::Text("final poses: %s", m.final_poses.empty() ? "from the assembled poses" : "");
   if (ImGui::IsItemHovered()) {
@@ -329,9 +329,8 @@ void RobotsPanel::JointSliders(AppState& app, const std::string& name) {
   if (it == scene.robots.end()) return;
   const SceneRobot& robot = *it;
   if (!ImGui::TreeNode("Joints (jog)")) return;
-  JointVector q = app.jog.count(name) && app.jog[name].size() == robot.home.size()
-                      ? app.jog[name]
-                      : robot.home;
+  JointVector q =
+      app.jog.count(name) && app.jog[name].size() == robot.home.size() ? app.jog[name] : robot.home;
   bool changed = false;
   for (size_t j = 0; j < robot.chain.joints.size() && static_cast<long>(j) < q.size(); ++j) {
     const Joint& joint = robot.chain.joints[j];
@@ -346,9 +345,10 @@ void RobotsPanel::JointSliders(AppState& app, const std::string& name) {
       changed = true;
     }
     if (ImGui::IsItemHovered()) {
-      ImGui::SetTooltip("Joint %zu of '%s', limits %.1f to %.1f%s: the viewport shows the arm here "
-                        "(not saved; the planner starts every robot at home)",
-                        j + 1, name.c_str(), lo, hi, revolute ? " deg" : " m");
+      ImGui::SetTooltip(
+          "Joint %zu of '%s', limits %.1f to %.1f%s: the viewport shows the arm here "
+          "(not saved; the planner starts every robot at home)",
+          j + 1, name.c_str(), lo, hi, revolute ? " deg" : " m");
     }
   }
   if (changed) app.jog[name] = q;

@@ -128,7 +128,8 @@ void PlannerPanel::Draw(AppState& app, const PanelRect& r) {
     const float f = prog.fraction >= 0 ? static_cast<float>(prog.fraction)
                                        : static_cast<float>(std::fmod(prog.elapsed_s, 1.0));
     ImGui::ProgressBar(f, ImVec2(-1, 0), (prog.stage + ": " + prog.message).c_str());
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s: %s", prog.stage.c_str(), prog.message.c_str());
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("%s: %s", prog.stage.c_str(), prog.message.c_str());
   }
   if (!prog.error.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
@@ -224,7 +225,7 @@ void PlanPanel::Contents(AppState& app) {
       if (std::find(a.robots.begin(), a.robots.end(), rb) == a.robots.end()) continue;
       const double end = keyframe_time[i];
       const double start = motion ? std::max(0.0, a.start_s) : end - (a.approach ? 2 : 1);
-      const ImU32 col = stale                              ? IM_COL32(90, 92, 96, 255)
+      const ImU32 col = stale                             ? IM_COL32(90, 92, 96, 255)
                         : a.type == ActionType::kAssemble ? IM_COL32(230, 140, 50, 255)
                         : a.type == ActionType::kPick     ? IM_COL32(80, 150, 220, 255)
                                                           : IM_COL32(120, 180, 120, 255);

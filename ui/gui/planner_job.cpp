@@ -131,8 +131,8 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
       std::lock_guard lock(mutex_);
       if (progress_.stages.empty() || progress_.stages.back().name != stage) {
         progress_.stages.push_back(
-            {stage, std::chrono::duration<double>(std::chrono::steady_clock::now() - started_)
-                        .count()});
+            {stage,
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count()});
       }
       progress_.stage = stage;
       progress_.fraction = fraction;

@@ -84,8 +84,7 @@ void SelectEntity(AppState& app, const EntityRef& entity) {
 std::string ProblemsPanel::Title(const AppState& app) {
   const ValidationResult v = app.validation.result();
   const int errors = v.diagnostics.error_count();
-  const int warnings =
-      v.diagnostics.warning_count() + static_cast<int>(app.run_warnings.size());
+  const int warnings = v.diagnostics.warning_count() + static_cast<int>(app.run_warnings.size());
   std::string title = "Problems";
   if (app.run_failure) title += " (no plan";
   if (errors + warnings > 0) {

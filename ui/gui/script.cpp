@@ -18,21 +18,47 @@ namespace {
 
 // Command name -> (least, most) arguments.
 const std::map<std::string, std::pair<int, int>>& Arity() {
-  static const std::map<std::string, std::pair<int, int>> arity = {
-      {"select", {2, 2}},        {"import", {1, 2}},    {"add-step", {1, 1}},
-      {"delete-step", {1, 1}},   {"rename", {2, 2}},    {"add-edge", {2, 2}},
-      {"remove-edge", {2, 2}},   {"add-robot", {2, 2}}, {"remove-robot", {1, 1}},
-      {"set", {2, 5}},           {"undo", {0, 0}},      {"redo", {0, 0}},
-      {"option", {2, 2}},        {"run", {0, 0}},       {"wait", {0, 0}},
-      {"expect-plan", {0, 0}},   {"scrub", {1, 1}},     {"play", {0, 0}},
-      {"pause", {0, 0}},         {"save", {0, 1}},      {"screenshot", {1, 1}},
-      {"expect-refused", {1, 6}}, {"autosave", {0, 0}},  {"sleep", {1, 1}},
-      {"add-urdf", {2, 4}},      {"view", {2, 2}},      {"new", {0, 0}},
-      {"open", {1, 1}},          {"validate", {0, 0}},  {"show", {1, 1}},
-      {"jog", {3, 3}},           {"measure", {2, 2}},   {"expect-problem", {1, 64}},
-      {"expect-no-problem", {1, 64}}, {"expect-marked", {1, 1}}, {"expect-selected", {2, 2}},
-      {"expect-plan-stale", {0, 0}},  {"expect-plan-current", {0, 0}},
-      {"expect-field-error", {1, 64}}, {"expect-undo", {1, 64}}, {"expect-viewport", {1, 1}}};
+  static const std::map<std::string, std::pair<int, int>> arity = {{"select", {2, 2}},
+                                                                   {"import", {1, 2}},
+                                                                   {"add-step", {1, 1}},
+                                                                   {"delete-step", {1, 1}},
+                                                                   {"rename", {2, 2}},
+                                                                   {"add-edge", {2, 2}},
+                                                                   {"remove-edge", {2, 2}},
+                                                                   {"add-robot", {2, 2}},
+                                                                   {"remove-robot", {1, 1}},
+                                                                   {"set", {2, 5}},
+                                                                   {"undo", {0, 0}},
+                                                                   {"redo", {0, 0}},
+                                                                   {"option", {2, 2}},
+                                                                   {"run", {0, 0}},
+                                                                   {"wait", {0, 0}},
+                                                                   {"expect-plan", {0, 0}},
+                                                                   {"scrub", {1, 1}},
+                                                                   {"play", {0, 0}},
+                                                                   {"pause", {0, 0}},
+                                                                   {"save", {0, 1}},
+                                                                   {"screenshot", {1, 1}},
+                                                                   {"expect-refused", {1, 6}},
+                                                                   {"autosave", {0, 0}},
+                                                                   {"sleep", {1, 1}},
+                                                                   {"add-urdf", {2, 4}},
+                                                                   {"view", {2, 2}},
+                                                                   {"new", {0, 0}},
+                                                                   {"open", {1, 1}},
+                                                                   {"validate", {0, 0}},
+                                                                   {"show", {1, 1}},
+                                                                   {"jog", {3, 3}},
+                                                                   {"measure", {2, 2}},
+                                                                   {"expect-problem", {1, 64}},
+                                                                   {"expect-no-problem", {1, 64}},
+                                                                   {"expect-marked", {1, 1}},
+                                                                   {"expect-selected", {2, 2}},
+                                                                   {"expect-plan-stale", {0, 0}},
+                                                                   {"expect-plan-current", {0, 0}},
+                                                                   {"expect-field-error", {1, 64}},
+                                                                   {"expect-undo", {1, 64}},
+                                                                   {"expect-viewport", {1, 1}}};
   return arity;
 }
 
@@ -241,9 +267,9 @@ Result<std::function<Result<void>(const AppState&)>> ExpectCheck(const ScriptLin
       if (found == want) return {};
       std::string shown;
       for (const std::string& l : lines) shown += "\n  " + l;
-      return fail(std::string(want ? "the Problems panel does not show '"
-                                   : "the Problems panel shows '") +
-                  text + "'; it shows:" + (shown.empty() ? " nothing" : shown));
+      return fail(
+          std::string(want ? "the Problems panel does not show '" : "the Problems panel shows '") +
+          text + "'; it shows:" + (shown.empty() ? " nothing" : shown));
     });
   }
   if (cmd == "expect-marked") {
@@ -504,8 +530,8 @@ Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const 
                           ? static_cast<int>(app.run_failure->failure->cases.size())
                           : 0;
     if (*n < 1 || *n > count) {
-      return LineError(line, "show N: the last run has " + std::to_string(count) +
-                                 " failed check(s) to show");
+      return LineError(
+          line, "show N: the last run has " + std::to_string(count) + " failed check(s) to show");
     }
     ShowFailureCase(app, static_cast<int>(*n) - 1);
     return effect;
@@ -519,8 +545,8 @@ Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const 
       if (r.name != w[1]) continue;
       const int j = static_cast<int>(*joint) - 1;
       if (j < 0 || j >= static_cast<int>(r.home.size())) {
-        return LineError(line, "robot '" + w[1] + "' has joints 1 to " +
-                                   std::to_string(r.home.size()));
+        return LineError(line,
+                         "robot '" + w[1] + "' has joints 1 to " + std::to_string(r.home.size()));
       }
       JointVector q = app.jog.count(w[1]) ? app.jog[w[1]] : r.home;
       q[j] = *deg * std::numbers::pi / 180.0;

@@ -49,8 +49,8 @@ void LiveValidation::Start(const Project& project, unsigned long revision,
     try {
       r.diagnostics = CheckProject(*snapshot, file).diagnostics;
     } catch (const std::exception& e) {
-      r.diagnostics.Error(file.string(), "", std::string("internal error while checking: ") +
-                                                 e.what());
+      r.diagnostics.Error(file.string(), "",
+                          std::string("internal error while checking: ") + e.what());
     }
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::lock_guard lock(mutex_);

@@ -17,8 +17,8 @@ namespace wrap::gui {
 
 /// What the last finished validation found.
 struct ValidationResult {
-  Diagnostics diagnostics;     ///< Errors and warnings, in the order they were found.
-  unsigned long revision = 0;  ///< Document revision that was checked (0: none yet).
+  Diagnostics diagnostics;                 ///< Errors and warnings, in the order they were found.
+  unsigned long revision = 0;              ///< Document revision that was checked (0: none yet).
   std::shared_ptr<const Project> project;  ///< The project as it was checked.
   double seconds = 0.0;                    ///< How long the check took [s].
 };

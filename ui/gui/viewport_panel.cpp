@@ -143,8 +143,8 @@ void ViewportPanel::Draw(AppState& app, const PanelRect& r) {
   GizmoTarget target;
   // The gizmo edits the document's poses: shown while the viewport draws the document (not a
   // current plan playing, not a failure on show).
-  const bool has_target = FindGizmoTarget(app, target) && app.showing_case < 0 &&
-                          !(app.plan && !app.PlanStale());
+  const bool has_target =
+      FindGizmoTarget(app, target) && app.showing_case < 0 && !(app.plan && !app.PlanStale());
   ImGui::SameLine();
   if (ImGui::RadioButton("move", app.gizmo == GizmoMode::kTranslate)) {
     app.gizmo = GizmoMode::kTranslate;
@@ -183,9 +183,9 @@ void ViewportPanel::Draw(AppState& app, const PanelRect& r) {
   cam.origin = p0;
   cam.size = ImVec2(rect.w, rect.h);
   const bool rotate = app.gizmo == GizmoMode::kRotate;
-  const int hovered_handle =
-      has_target && ImGui::IsItemHovered() ? GizmoHandleAt(cam, target.pivot_W, rotate, io.MousePos)
-                                           : -1;
+  const int hovered_handle = has_target && ImGui::IsItemHovered()
+                                 ? GizmoHandleAt(cam, target.pivot_W, rotate, io.MousePos)
+                                 : -1;
   if (ImGui::IsItemHovered() && io.MouseWheel != 0.0f) app.viewport.Zoom(-0.05 * io.MouseWheel);
   // What a drag does is decided when the mouse goes down.
   if (ImGui::IsItemActivated()) {
@@ -217,7 +217,8 @@ void ViewportPanel::Draw(AppState& app, const PanelRect& r) {
   if (ImGui::IsItemDeactivated()) {
     app.doc.CloseMerge();
     // A click (press and release without moving) selects the part under the mouse.
-    if (drag == Drag::kCamera && std::hypot(io.MousePos.x - press.x, io.MousePos.y - press.y) < 3.0f &&
+    if (drag == Drag::kCamera &&
+        std::hypot(io.MousePos.x - press.x, io.MousePos.y - press.y) < 3.0f &&
         ImGui::IsMouseReleased(ImGuiMouseButton_Left)) {
       const double rx = (io.MousePos.x - rect.x) / rect.w;
       const double ry = 1.0 - (io.MousePos.y - rect.y) / rect.h;

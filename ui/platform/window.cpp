@@ -63,8 +63,8 @@ struct KeyEvent {
   int key, scancode, action, mods;
   int deliver_at;  // frame number
 };
-int frame_number = 0;    // counts BeginFrame calls
-bool polling = false;    // inside BeginFrame's poll (events reach this frame, else the next)
+int frame_number = 0;  // counts BeginFrame calls
+bool polling = false;  // inside BeginFrame's poll (events reach this frame, else the next)
 std::vector<std::pair<int, int>> key_seen;  // key -> frame its last press reaches ImGui
 std::vector<KeyEvent> deferred_releases;
 

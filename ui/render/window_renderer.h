@@ -37,8 +37,8 @@ struct SceneMarker {
 /// that collided), glowing so it shows on any colour.
 struct SceneHighlight {
   enum class Kind { kPart, kRobot, kTable };
-  Kind kind = Kind::kPart;            ///< What it is.
-  int index = -1;                     ///< Part or robot index in the scene; unused for the table.
+  Kind kind = Kind::kPart;              ///< What it is.
+  int index = -1;                       ///< Part or robot index in the scene; unused for the table.
   Rgba color = {0.95, 0.15, 0.1, 1.0};  ///< Colour it is tinted towards.
 };
 
