@@ -3,13 +3,22 @@
 #include <cstdio>
 #include <ostream>
 
+#include "model/project_io.h"
 #include "robot/robot_check.h"
 
 namespace wrap::cli {
 
 LoadedProject LoadChecked(const std::string& project) {
-  LoadedProject loaded = LoadProject(project);
-  if (loaded.project) loaded.check.diagnostics.Append(CheckRobots(*loaded.project, project));
+  // Parse, then the checks the GUI's live validation makes too (CheckProject).
+  LoadedProject loaded;
+  ProjectParse parse = ReadProjectFile(project);
+  loaded.check.diagnostics = std::move(parse.diagnostics);
+  if (!parse.project) return loaded;
+  ProjectCheck check = CheckProject(*parse.project, project);
+  loaded.check.diagnostics.Append(check.diagnostics);
+  loaded.check.parts = std::move(check.parts);
+  loaded.check.tree = std::move(check.tree);
+  loaded.project = std::move(parse.project);
   return loaded;
 }
 

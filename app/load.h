@@ -9,7 +9,7 @@
 
 namespace wrap::cli {
 
-/// The model's LoadProject plus the robot stage's CheckRobots (URDFs import, catalog loads).
+/// Parses the file, then CheckProject (the model's validation and the robot stage's checks).
 LoadedProject LoadChecked(const std::string& project);
 
 /// Prints the load's diagnostics to `err` (all of them, or with `warnings` false only when the

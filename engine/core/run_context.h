@@ -50,6 +50,8 @@ class RunContext {
   bool timed_out() const { return Clock::now() >= deadline_; }
   /// True when the run must stop now (cancelled or past its deadline).
   bool ShouldStop() const { return cancelled() || timed_out(); }
+  /// The progress sink (empty when none), for a sub-run that reports through this one.
+  const ProgressFn& progress_fn() const { return progress_; }
   /// Reports progress to the sink, if any.
   void Progress(const std::string& stage, double fraction, const std::string& message) const {
     if (progress_) progress_(stage, fraction, message);

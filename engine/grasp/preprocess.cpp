@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -104,25 +105,43 @@ std::vector<int> FarthestPointOrder(const std::vector<Vec3>& x, const std::vecto
   return order;
 }
 
+// Times the phases of the preprocessing and reports the next one as progress.
 class Lap {
  public:
-  explicit Lap(StageTimes& times) : times_(times), last_(Clock::now()), start_(last_) {}
+  Lap(StageTimes& times, const RunContext& ctx)
+      : times_(times), ctx_(ctx), last_(Clock::now()), start_(last_) {
+    Report();
+  }
   void operator()(const std::string& key) {
     const auto now = Clock::now();
     times_[key] += std::chrono::duration<double>(now - last_).count();
     last_ = now;
+    ++done_;
+    Report();
   }
   void Total() { times_["total"] = std::chrono::duration<double>(Clock::now() - start_).count(); }
 
  private:
+  void Report() const {
+    static constexpr const char* kPhases[] = {
+        "subassemblies",     "convex hulls",
+        "stable placements", "table slots (IK over the table)",
+        "grasp candidates",  "grasp selection"};
+    constexpr int n = static_cast<int>(std::size(kPhases));
+    if (done_ >= n) return;
+    ctx_.Progress("preprocess", static_cast<double>(done_) / n,
+                  std::to_string(done_ + 1) + "/" + std::to_string(n) + ": " + kPhases[done_]);
+  }
   StageTimes& times_;
+  const RunContext& ctx_;
   Clock::time_point last_, start_;
+  int done_ = 0;
 };
 
 Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
                          const PreprocessOptions& options, RunContext& ctx) {
   Preprocessed out;
-  Lap lap(out.times);
+  Lap lap(out.times, ctx);
   out.grasps_per_set = options.grasps > 0 ? options.grasps : project.planner.grasps;
   if (out.grasps_per_set <= 0) {
     return Fail(ErrorCode::kInvalidInput,

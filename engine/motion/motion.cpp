@@ -100,6 +100,8 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
     if (segments->empty()) return out;
     t0 = std::chrono::steady_clock::now();
     plan.actions = std::move(work.actions);
+    ctx.Progress("retime", -1.0,
+                 std::to_string(segments->size()) + " segments timed into per-robot trajectories");
     auto timing = Retime(world, plan, *segments);
     // Where an object carried by one robot would load its gripper beyond kMaxLoad with its
     // weight and inertia, that segment runs slower (the inertial part falls with the square of
@@ -152,6 +154,7 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
     plan.stats.motion_segments = static_cast<int>(segments->size());
     if (!options.self_check) break;
     t0 = std::chrono::steady_clock::now();
+    ctx.Progress("check", -1.0, "the timed trajectories, densely");
     auto check = CheckTrajectories(world, plan, TrajectoryCheckOptions{});
     out.t_mp_s += Since(t0);
     if (!check) return std::unexpected(check.error());

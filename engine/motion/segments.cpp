@@ -101,6 +101,9 @@ class Builder {
                         const std::vector<int>& table_ok = {},
                         const std::vector<std::pair<int, int>>& gripper_ok = {});
   bool Fail(int action, SegmentKind kind, bool suspend, const std::string& message, int blame = -1);
+  // The cell as it stands for the failure record: every robot where it is (cur_), the parts as
+  // the scene has them.
+  FailureScene CellNow();
   Iso3 Tcp(int robot, const JointVector& q) const {
     const TaskRobot& r = w_.robots[robot];
     return TcpPose(r.chain, r.X_WB, q, r.end_effector.X_FT);
@@ -219,6 +222,7 @@ class Builder {
   int free_index_ = 0;
   bool cancelled_ = false;
   std::string last_hit_;  // the bodies of the last collision PathClear met
+  FailureScene last_hit_scene_;  // and the cell at it
   bool hover_ = false;    // the carries' goal is a hover pose, not a keyframe: no rebranching
   bool jump_ = false;     // a segment did not start where its robots were (see Push)
   std::mt19937_64 rng_;
@@ -242,8 +246,21 @@ bool Builder::Fail(int action, SegmentKind kind, bool suspend, const std::string
     failure_->segment = std::string(ToString(kind));
     failure_->suspend = suspend;
     failure_->message = message;
+    // The collision the message names, where it happened; else the cell where the segment
+    // starts.
+    const bool named = !last_hit_.empty() && message.find(last_hit_) != std::string::npos &&
+                       !last_hit_scene_.q.empty();
+    failure_->scene = named ? last_hit_scene_ : CellNow();
   }
   return false;
+}
+
+FailureScene Builder::CellNow() {
+  FailureScene scene;
+  scene.q = cur_;
+  scene.X_WP.resize(w_.num_parts);
+  for (int p = 0; p < w_.num_parts; ++p) scene.X_WP[p] = scene_.cell().object_pose(p);
+  return scene;
 }
 
 void Builder::Push(GeoSegment seg) {
@@ -473,6 +490,13 @@ bool Builder::PathClear(const std::vector<int>& robots,
         const CollisionWorld& cw = scene_.cell().world();
         last_hit_ = "'" + cw.body_name(hit.first.body_a) + "' hits '" +
                     cw.body_name(hit.first.body_b) + "'";
+        // The failure record's picture: the robots where they hit, the parts as set.
+        last_hit_scene_ = CellNow();
+        for (size_t i = 0; i < robots.size(); ++i) {
+          last_hit_scene_.q[robots[i]] =
+              waypoints[prev][i] + t * (waypoints[k][i] - waypoints[prev][i]);
+        }
+        last_hit_scene_.bodies = {cw.body_name(hit.first.body_a), cw.body_name(hit.first.body_b)};
         return false;
       }
     }
@@ -611,6 +635,14 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
   }
   if (movers.empty()) return true;
   const int index = free_index_++;
+  {
+    std::string names;
+    for (int r : movers) names += (names.empty() ? "" : ", ") + Name(r);
+    ctx_.Progress("motion", static_cast<double>(action) / std::max<size_t>(1, plan_.actions.size()),
+                  "action " + std::to_string(action + 1) + "/" +
+                      std::to_string(plan_.actions.size()) + ": free path " +
+                      std::to_string(index + 1) + " for " + names);
+  }
   if (cache_.free_paths.size() <= static_cast<size_t>(index)) cache_.free_paths.resize(index + 1);
   GeoSegment seg;
   seg.kind = SegmentKind::kFree;
@@ -1767,6 +1799,9 @@ Result<std::vector<GeoSegment>> Builder::Run() {
   }
   for (size_t i = 0; i < plan_.actions.size(); ++i) {
     if (ctx_.cancelled()) return wrap::Fail(ErrorCode::kCancelled, "motion planning cancelled");
+    ctx_.Progress("motion", static_cast<double>(i) / plan_.actions.size(),
+                  "action " + std::to_string(i + 1) + "/" + std::to_string(plan_.actions.size()) +
+                      ": " + DescribeAction(plan_, plan_.actions[i]));
     if (!Action(static_cast<int>(i)) || jump_) {
       if (cancelled_ || ctx_.cancelled()) {
         return wrap::Fail(ErrorCode::kCancelled, "motion planning cancelled");

@@ -88,6 +88,9 @@ struct MotionFailure {
   std::string segment;   ///< Its kind.
   bool suspend = false;  ///< True when more effort may find it (a path search ran out of time).
   std::string message;   ///< The segment and the reason, in words.
+  /// The cell at the collision the message names (robots where they hit, the two bodies), or
+  /// where the segment starts.
+  FailureScene scene;
 };
 
 /// Solved free paths of one plan, kept across effort levels (by free segment index).

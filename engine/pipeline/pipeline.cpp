@@ -37,6 +37,40 @@ std::uint64_t Signature(const Plan& plan) {
   return h;
 }
 
+// The motion stage's failure record of `plan`'s motion failure `f` (the words: `words`).
+PlanFailure MotionFailureRecord(const Plan& plan, const MotionFailure& f,
+                                const std::string& words) {
+  PlanFailure d;
+  d.stage = "motion";
+  d.action = f.action;
+  d.segment = f.segment;
+  d.start = f.scene;
+  FailureCase c;
+  c.check = f.segment + " segment";
+  c.count = 1;
+  c.text = words;
+  c.example = f.message;
+  c.scene = f.scene;
+  if (f.action >= 0 && f.action < static_cast<int>(plan.actions.size())) {
+    const PlanAction& a = plan.actions[f.action];
+    d.robots = a.robots;
+    d.milestone = a.milestone;
+    if (a.milestone >= 0 && a.milestone < static_cast<int>(plan.milestone_steps.size())) {
+      d.step = plan.milestone_steps[a.milestone];
+    }
+    c.example += " (action " + std::to_string(f.action + 1) + ": " + DescribeAction(plan, a) + ")";
+    c.robot = a.robots.empty() ? -1 : a.robots.front();
+    c.object = a.objects.empty() ? -1 : a.objects.front();
+    if (!a.grasps.empty() && a.grasps.front().grasp.part >= 0) {
+      c.grasp_part = a.grasps.front().grasp.part;
+      c.X_PG = a.grasps.front().grasp.X_PG;
+      c.grasp_index = a.grasps.front().grasp.index;
+    }
+  }
+  d.cases = {std::move(c)};
+  return d;
+}
+
 }  // namespace
 
 Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
@@ -65,6 +99,7 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
   double t_retime = 0.0;
   std::optional<Plan> fallback;  // the first task plan, returned when no motion is found
   std::string last_failure;
+  std::optional<PlanFailure> last_detail;  // the same as data
   // Motion feedback: the edges of the task plans whose motion failed for good (a skill that
   // collides, a goal in collision, or every effort spent) are not taken by later task plans;
   // without it a task search that does not depend on its seed would make the same plan again.
@@ -74,6 +109,9 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
 
   auto enqueue = [&](Plan plan) -> Result<void> {
     if (options.optimize_keyframes && !std::getenv("WRAP_NO_KFOPT")) {
+      ctx.Progress("keyframes", -1.0,
+                   "optimising the joint keyframes of task plan " + std::to_string(made) + " (" +
+                       std::to_string(plan.actions.size()) + " actions)");
       const auto t0 = std::chrono::steady_clock::now();
       auto report = OptimizeKeyframes(*world, plan, options.keyframes, ctx);
       t_kf += Since(t0);
@@ -116,6 +154,10 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
       sub.set_deadline(ctx.deadline());
       sub.set_stop_token(ctx.stop_token());
       ++made;
+      sub.set_progress(
+          [&ctx, n = made](const std::string& stage, double fraction, const std::string& message) {
+            ctx.Progress(stage, fraction, "task plan " + std::to_string(n) + ": " + message);
+          });
       auto next = PlanTask(project, check, pre, task, sub);
       if (!next) {
         if (next.error().code == ErrorCode::kCancelled) return std::unexpected(next.error());
@@ -138,6 +180,10 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
       if (queue[k].effort < queue[pick].effort) pick = k;
     }
     Candidate& c = queue[pick];
+    ctx.Progress("motion", 0.0,
+                 "task plan " + std::to_string(c.order + 1) + " of " + std::to_string(made) +
+                     ", effort " + std::to_string(c.effort) + " (" + std::to_string(suspensions) +
+                     " suspensions so far)");
     auto attempt = PlanMotion(*world, c.plan, options.motion, c.effort,
                               c.plan.stats.seed ^ 0x4d50ULL, c.cache, ctx);
     if (!attempt) {
@@ -159,6 +205,10 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
     const MotionFailure& f = attempt->failure;
     last_failure =
         "action " + std::to_string(f.action + 1) + ", " + f.segment + " segment: " + f.message;
+    last_detail = MotionFailureRecord(c.plan, f, last_failure);
+    ctx.Progress("motion", -1.0,
+                 (f.suspend && c.effort < options.motion.max_effort ? "suspended: " : "failed: ") +
+                     last_failure);
     if (std::getenv("WRAP_MOTION_DEBUG")) {
       std::fprintf(stderr, "[motion] plan %d effort %d: %s%s\n", c.order, c.effort,
                    last_failure.c_str(), f.suspend ? " (suspended)" : "");
@@ -188,6 +238,12 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
                        " found (" + std::to_string(made) + " tried" +
                        (ctx.timed_out() ? ", time limit reached" : "") +
                        "); last: " + (last_failure.empty() ? "none planned" : last_failure);
+  if (last_detail) {
+    last_detail->text = plan.stats.failure;
+    plan.stats.failure_detail = std::move(last_detail);
+  } else {
+    plan.stats.failure_detail.reset();
+  }
   return plan;
 }
 

@@ -5,6 +5,7 @@
 
 #include "core/diagnostics.h"
 #include "model/project.h"
+#include "model/validate.h"
 
 namespace wrap {
 
@@ -13,5 +14,10 @@ namespace wrap {
 /// JSON path (`robots[i].urdf`, ...) with the importer's message. `wrap validate` runs it after
 /// the model's validation; robots that validation already rejected are skipped.
 Diagnostics CheckRobots(const Project& project, const std::filesystem::path& project_file);
+
+/// Every check `wrap validate` makes of a parsed project: the model's ValidateProject, then
+/// CheckRobots. The GUI's live validation and its planner runs call this one function, so a
+/// check added to either appears in both faces.
+ProjectCheck CheckProject(const Project& project, const std::filesystem::path& project_file);
 
 }  // namespace wrap

@@ -369,6 +369,10 @@ bool KeyframeSolver::SolveIk(int robot, const Iso3& X_WT, const JointVector& ref
 }
 
 void KeyframeSolver::SetRobot(int robot, const JointVector& q) {
+  if (explain_) {
+    if (q_now_.size() != world_.robots.size()) q_now_.resize(world_.robots.size());
+    q_now_[robot] = q;
+  }
   ForwardKinematics(world_.robots[robot].chain, world_.robots[robot].X_WB, q, frames_[robot]);
   cell_.SetConfiguration(robot, std::span<const double>(q.data(), q.size()), frames_[robot]);
   PlaceFingers(robot, cell_.X_WF(robot));
@@ -387,10 +391,20 @@ void KeyframeSolver::EnableRobot(int robot, bool on) {
 bool KeyframeSolver::Collides() {
   ++counters_.collision_checks;
   static const bool debug = std::getenv("WRAP_TASK_DEBUG_COLLISIONS") != nullptr;
-  if (!debug) return cell_.InCollision();
+  if (!debug && !explain_) return cell_.InCollision();
   CollisionResult result;
   const bool hit = cell_.InCollision(&result);
-  if (hit) std::fprintf(stderr, "[task]     collision: %s\n", cell_.Describe(result.first).c_str());
+  if (hit && debug) {
+    std::fprintf(stderr, "[task]     collision: %s\n", cell_.Describe(result.first).c_str());
+  }
+  if (hit && explain_) {
+    // The failure record's picture of it: every robot's joints, every part's pose, the bodies.
+    const CollisionWorld& w = cell_.world();
+    hit_.q = q_now_;
+    hit_.X_WP.resize(world_.num_parts);
+    for (int p = 0; p < world_.num_parts; ++p) hit_.X_WP[p] = cell_.object_pose(p);
+    hit_.bodies = {w.body_name(result.first.body_a), w.body_name(result.first.body_b)};
+  }
   return hit;
 }
 
@@ -621,6 +635,10 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
   ++counters_.validations;
   const auto start = Clock::now();
   const double lp_before = counters_.t_lp_s;
+  hit_ = FailureScene{};
+  if (explain_) {
+    q_now_ = c.q;  // robots not set below stay where the state has them
+  }
   std::mt19937_64 rng(HashMix(seed, static_cast<std::uint64_t>(effort) + 11));
   effort = std::clamp(effort, 0, 2);
   const int n_robots = static_cast<int>(world_.robots.size());
@@ -1220,6 +1238,9 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
     out.ok = false;
     out.gate = worst;
     out.message = why;
+    if (worst == Gate::kCollision || worst == Gate::kSkill || worst == Gate::kApproach) {
+      out.scene = std::move(hit_);
+    }
     // Closed-form IK at a fixed pose (nothing sampled) or a wrench failure: effort cannot help.
     const bool wrench_only = worst == Gate::kWrenchAssembly || worst == Gate::kWrenchRest ||
                              worst == Gate::kWrenchRelease ||

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "robot/cell.h"
+#include "task/failure.h"
 #include "task/planner.h"
 #include "task/state.h"
 #include "task/world.h"
@@ -60,6 +61,9 @@ struct EdgeOutcome {
   Keyframe keyframe;        ///< The keyframe (ok only).
   std::optional<Keyframe> approach;
   ContState next;  ///< Continuous state after the action (ok only).
+  /// Failed by a collision while explaining (KeyframeSolver::set_explain): the cell at the last
+  /// collision found, with the two bodies.
+  FailureScene scene;
 };
 
 /// Validates edges and answers the cheap checks. Holds a copy of the cell: one per thread.
@@ -72,6 +76,10 @@ class KeyframeSolver {
   /// after it. `seed` makes the pose sampling deterministic.
   EdgeOutcome Validate(const SymState& s, const ContState& c, const TaskAction& a,
                        const SymState& next, int effort, std::uint64_t seed);
+
+  /// While on, Validate records the cell at each collision it finds (EdgeOutcome::scene), for
+  /// the failure record; off (the default) it only counts them.
+  void set_explain(bool on) { explain_ = on; }
 
   /// Cheap: the TCP pose is inside the robot's reach sphere.
   bool InReach(int robot, const Iso3& X_WT) const;
@@ -159,6 +167,9 @@ class KeyframeSolver {
   };
   std::vector<std::optional<Fingers>> fingers_;  // per robot (two-finger grippers)
   std::vector<double> opening_;                  // per robot: current finger opening
+  bool explain_ = false;                         // record the cell at collisions
+  std::vector<JointVector> q_now_;               // per robot: the joints last set
+  FailureScene hit_;                             // the cell at the last collision recorded
   void PlaceFingers(int robot, const Iso3& X_WF);
 };
 

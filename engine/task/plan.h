@@ -42,6 +42,7 @@
 #include "core/pose.h"
 #include "core/run_context.h"
 #include "robot/kinematics.h"
+#include "task/failure.h"
 
 namespace wrap {
 
@@ -189,6 +190,9 @@ struct PlanStats {
   /// and at every improvement.
   std::vector<std::pair<double, int>> cost_history;
   std::string failure;  ///< Empty when solved, else why not, in words.
+  /// The same as data when not solved (where it failed and the checks that failed there, with
+  /// the cell at each); absent when solved or when the planner could not say. Not saved.
+  std::optional<PlanFailure> failure_detail;
   // Motion (paper §IV-D keyframe optimisation, §IV-E motion planning, §IV-F retiming).
   bool motion = false;                 ///< Trajectories were planned (false: task plan only).
   double t_kf_s = 0.0;                 ///< Joint keyframe optimisation [s].

@@ -18,6 +18,17 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// The task stage's failure record of milestone `milestone` (step node `step`; -1 for flat).
+PlanFailure MilestoneFailure(int milestone, int step, MilestoneResult& r) {
+  PlanFailure f;
+  f.stage = "task";
+  f.milestone = milestone;
+  f.step = step;
+  f.start = std::move(r.start);
+  f.cases = std::move(r.cases);
+  return f;
+}
+
 std::string ModeName(MatingWrenchMode mode) {
   switch (mode) {
     case MatingWrenchMode::kFull:
@@ -205,6 +216,7 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   int k = 0;
   int backtracks = 0;
   std::string failure;
+  PlanFailure detail;  // the failure as data, following `failure`
   bool stopped = false;
   bool out_of_memory = false;
   while (k < K) {
@@ -232,6 +244,7 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
       stopped = r.stopped;
       out_of_memory = r.out_of_memory;
       failure = words + " was being planned; checks that failed most: " + r.failure;
+      detail = MilestoneFailure(flat ? -1 : k, flat ? -1 : order[k], r);
       if (out_of_memory) {
         failure = "out of memory (the search held more than the " +
                   std::to_string(options.memory_limit_mb) + " MiB limit) while " + failure;
@@ -239,6 +252,7 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
       break;
     }
     failure = r.failure;
+    detail = MilestoneFailure(flat ? -1 : k, flat ? -1 : order[k], r);
     if (std::getenv("WRAP_TASK_DEBUG")) std::fprintf(stderr, "[task] %s\n", failure.c_str());
     if (!flat && k > 0 && backtracks < options.max_backtracks) {
       excluded[k - 1].insert(results[k - 1].end.Hash());
@@ -314,6 +328,8 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
     }
     if (failure.empty()) failure = "no plan";
     st.failure = failure;
+    detail.text = failure;
+    st.failure_detail = std::move(detail);
   }
   return plan;
 }

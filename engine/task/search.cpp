@@ -38,39 +38,37 @@ std::uint64_t EdgeKey(const SymState& s, const TaskAction& a) {
 
 }  // namespace
 
-void GateTally::Add(Gate gate, const std::string& message) {
+void GateTally::Add(Gate gate, const std::string& message, const CheckSubject& about) {
   const int i = static_cast<int>(gate);
   ++count[i];
-  if (example[i].empty()) example[i] = message;
+  if (example[i].empty()) {
+    example[i] = message;
+    subject[i] = about;
+  }
   last_gate = gate;
   last_message = message;
+  last_subject = about;
 }
 
 bool TaskSearch::Recall(std::uint64_t key, const CheapAnswer& answer) {
   // Counted once per milestone: the tally counts distinct questions, not how often the search
   // met them.
-  if (!answer.ok && tallied_.insert(key).second) tally_.Add(answer.gate, answer.why);
+  if (!answer.ok && tallied_.insert(key).second) tally_.Add(answer.gate, answer.why, answer.about);
   return answer.ok;
 }
 
 void TaskSearch::Remember(std::uint64_t key, bool ok) {
   tallied_.insert(key);
-  cheap_[key] = ok ? CheapAnswer{} : CheapAnswer{false, tally_.last_gate, tally_.last_message};
+  cheap_[key] = ok ? CheapAnswer{}
+                   : CheapAnswer{false, tally_.last_gate, tally_.last_message, tally_.last_subject};
 }
 
 std::string GateTally::Summary(int max_gates) const {
-  std::vector<int> order;
-  for (int i = 1; i < kNumGates; ++i) {
-    if (count[i] > 0) order.push_back(i);
-  }
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return count[a] > count[b]; });
+  const std::vector<Gate> order = Order();
   std::string out;
   for (int k = 0; k < static_cast<int>(order.size()) && k < max_gates; ++k) {
-    const int i = order[k];
     if (!out.empty()) out += "; ";
-    out +=
-        std::string(GateName(static_cast<Gate>(i))) + " failed " + std::to_string(count[i]) + "x";
-    if (!example[i].empty()) out += " (e.g. " + example[i] + ")";
+    out += Words(order[k]);
   }
   return out.empty() ? "no candidate action passed the cheap checks" : out;
 }
@@ -316,20 +314,32 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
   const Iso3 X_WA = tables_.location(loc).X_WA;
   const Iso3 target = solver_.GraspTarget(X_WA, grasp);
   bool ok = solver_.InReach(robot, target);
+  CheckSubject about;
+  about.object = node;
+  about.robot = robot;
+  about.grasp = grasp;
+  about.loc = loc;
   if (!ok)
-    tally_.Add(Gate::kReach, "'" + world_.robots[robot].name + "' cannot reach grasp " +
-                                 std::to_string(tables_.grasp(grasp).index) + " of '" +
-                                 world_.tree->nodes[node].name + "' where it rests");
+    tally_.Add(Gate::kReach,
+               "'" + world_.robots[robot].name + "' cannot reach grasp " +
+                   std::to_string(tables_.grasp(grasp).index) + " of '" +
+                   world_.tree->nodes[node].name + "' where it rests",
+               about);
   if (ok && !solver_.ClearOfTable(robot, target, solver_.GraspOpening(grasp))) {
     ok = false;
-    tally_.Add(Gate::kCollision, "grasp " + std::to_string(tables_.grasp(grasp).index) + " of '" +
-                                     world_.tree->nodes[node].name +
-                                     "' puts the gripper into the table where it rests");
+    CheckSubject hit = about;
+    hit.hit_table = true;
+    tally_.Add(Gate::kCollision,
+               "grasp " + std::to_string(tables_.grasp(grasp).index) + " of '" +
+                   world_.tree->nodes[node].name +
+                   "' puts the gripper into the table where it rests",
+               hit);
   }
   if (ok) {
     std::string why;
     ok = solver_.SoloReach(robot, {{node, X_WA, true}}, grasp, &why);
-    if (!ok) tally_.Add(Gate::kIk, why + " where '" + world_.tree->nodes[node].name + "' rests");
+    if (!ok)
+      tally_.Add(Gate::kIk, why + " where '" + world_.tree->nodes[node].name + "' rests", about);
   }
   if (ok) {
     // Transport right after the lift: deterministic, so checked here.
@@ -338,7 +348,7 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
     const std::uint64_t lp_key =
         HashMix(HashMix(HashMix(1, static_cast<std::uint64_t>(loc) + 100), robot), grasp);
     ok = solver_.Wrench(WrenchGate::kTransport, {&obj, 1}, -1, lp_key, &why);
-    if (!ok) tally_.Add(Gate::kWrenchTransport, why);
+    if (!ok) tally_.Add(Gate::kWrenchTransport, why, about);
   }
   Remember(key, ok);
   return ok;
@@ -356,30 +366,46 @@ bool TaskSearch::CheapPlace(int robot, int node, int loc, int grasp) {
   const Iso3 X_WA = tables_.location(loc).X_WA;
   const Iso3 target = solver_.GraspTarget(X_WA, grasp);
   bool ok = solver_.InReach(robot, target);
+  CheckSubject about;
+  about.object = node;
+  about.robot = robot;
+  about.grasp = grasp;
+  about.loc = loc;
   if (!ok)
-    tally_.Add(Gate::kReach, "'" + world_.robots[robot].name + "' cannot reach to set '" +
-                                 world_.tree->nodes[node].name + "' down there");
+    tally_.Add(Gate::kReach,
+               "'" + world_.robots[robot].name + "' cannot reach to set '" +
+                   world_.tree->nodes[node].name + "' down there",
+               about);
   if (ok && !solver_.ClearOfTable(robot, target, solver_.GraspOpening(grasp))) {
     ok = false;
+    CheckSubject hit = about;
+    hit.hit_table = true;
     tally_.Add(Gate::kCollision,
                "setting '" + world_.tree->nodes[node].name + "' down with grasp " +
-                   std::to_string(tables_.grasp(grasp).index) + " puts the gripper into the table");
+                   std::to_string(tables_.grasp(grasp).index) + " puts the gripper into the table",
+               hit);
   }
   if (ok && !HomesClear(node, loc)) {
     ok = false;
-    tally_.Add(Gate::kCollision, "'" + world_.tree->nodes[node].name +
-                                     "' set down there would be in the way of a robot at home");
+    CheckSubject in_way = about;
+    in_way.robot = -1;
+    in_way.grasp = -1;
+    tally_.Add(Gate::kCollision,
+               "'" + world_.tree->nodes[node].name +
+                   "' set down there would be in the way of a robot at home",
+               in_way);
   }
   if (ok) {
     std::string why;
     ok = solver_.SoloReach(robot, {{node, X_WA, true}}, grasp, &why);
-    if (!ok) tally_.Add(Gate::kIk, why + " to set '" + world_.tree->nodes[node].name + "' down");
+    if (!ok)
+      tally_.Add(Gate::kIk, why + " to set '" + world_.tree->nodes[node].name + "' down", about);
   }
   if (ok) {
     const WrenchObject obj{node, X_WA, true, {}};
     std::string why;
     ok = solver_.Wrench(WrenchGate::kRest, {&obj, 1}, -1, HashMix(2, loc + 1), &why);
-    if (!ok) tally_.Add(Gate::kWrenchRest, why);
+    if (!ok) tally_.Add(Gate::kWrenchRest, why, about);
   }
   Remember(key, ok);
   return ok;
@@ -396,25 +422,41 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
   if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(key, it->second);
   bool ok = true;
   std::string why;
+  // What the checks are about: the moved input where it is mated (on the resting base, or at
+  // the base's frame when both are in the air), held by its first holder.
+  auto about = [&](int robot, int grasp, int node, int hit_node) {
+    CheckSubject a;
+    a.object = node;
+    a.robot = robot;
+    a.grasp = grasp;
+    if (b_rests) a.X_WA = tables_.location(s.loc[m.base]).X_WA;
+    a.hit_node = hit_node;
+    return a;
+  };
+  const int r0 = mh.empty() ? -1 : mh.front().first, g0 = mh.empty() ? -1 : mh.front().second;
   // Context-free: no gripper may touch the other input at the mating pose.
   {
     const Iso3 X = b_rests ? tables_.location(s.loc[m.base]).X_WA : Iso3::Identity();
     for (const auto& [r, g] : mh) {
       if (ok && !solver_.GripperClear(r, g, X, m.base, X)) {
         ok = false;
-        tally_.Add(Gate::kCollision, "the gripper of '" + world_.robots[r].name + "' at grasp " +
-                                         std::to_string(tables_.grasp(g).index) + " of '" +
-                                         world_.tree->nodes[m.moved].name + "' hits '" +
-                                         world_.tree->nodes[m.base].name + "' when mated");
+        tally_.Add(Gate::kCollision,
+                   "the gripper of '" + world_.robots[r].name + "' at grasp " +
+                       std::to_string(tables_.grasp(g).index) + " of '" +
+                       world_.tree->nodes[m.moved].name + "' hits '" +
+                       world_.tree->nodes[m.base].name + "' when mated",
+                   about(r, g, m.moved, m.base));
       }
     }
     for (const auto& [r, g] : bh) {
       if (ok && !solver_.GripperClear(r, g, X, m.moved, X)) {
         ok = false;
-        tally_.Add(Gate::kCollision, "the gripper of '" + world_.robots[r].name + "' at grasp " +
-                                         std::to_string(tables_.grasp(g).index) + " of '" +
-                                         world_.tree->nodes[m.base].name + "' hits '" +
-                                         world_.tree->nodes[m.moved].name + "' when mated");
+        tally_.Add(Gate::kCollision,
+                   "the gripper of '" + world_.robots[r].name + "' at grasp " +
+                       std::to_string(tables_.grasp(g).index) + " of '" +
+                       world_.tree->nodes[m.base].name + "' hits '" +
+                       world_.tree->nodes[m.moved].name + "' when mated",
+                   about(r, g, m.base, m.moved));
       }
     }
   }
@@ -426,9 +468,11 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
       if (!solver_.InReach(r, target) ||
           !solver_.ClearOfTable(r, target, solver_.GraspOpening(g))) {
         ok = false;
-        tally_.Add(Gate::kReach, "'" + world_.robots[r].name + "' cannot bring '" +
-                                     world_.tree->nodes[m.moved].name + "' to '" +
-                                     world_.tree->nodes[m.base].name + "' where it rests");
+        tally_.Add(Gate::kReach,
+                   "'" + world_.robots[r].name + "' cannot bring '" +
+                       world_.tree->nodes[m.moved].name + "' to '" +
+                       world_.tree->nodes[m.base].name + "' where it rests",
+                   about(r, g, m.moved, -1));
       }
     }
     const bool m_touches = std::abs(LowestPoint(world_, m.moved, X_WB) - world_.table_top) <= 2e-3;
@@ -437,30 +481,37 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
       std::string solo;
       ok = solver_.SoloReach(r, {{m.moved, X_WB, m_touches}, {m.base, X_WB, true}}, g, &solo);
       if (!ok)
-        tally_.Add(Gate::kIk, solo + " to insert '" + world_.tree->nodes[m.moved].name + "'");
+        tally_.Add(Gate::kIk, solo + " to insert '" + world_.tree->nodes[m.moved].name + "'",
+                   about(r, g, m.moved, -1));
     }
     if (ok && !solver_.ClearOfHomes(m.step, X_WB)) {
       ok = false;
-      tally_.Add(Gate::kCollision, "'" + world_.tree->nodes[m.step].name + "' built where '" +
-                                       world_.tree->nodes[m.base].name +
-                                       "' rests would be in the way of a robot at home");
+      tally_.Add(Gate::kCollision,
+                 "'" + world_.tree->nodes[m.step].name + "' built where '" +
+                     world_.tree->nodes[m.base].name +
+                     "' rests would be in the way of a robot at home",
+                 about(-1, -1, m.moved, -1));
     }
     if (ok && LowestPoint(world_, m.moved, X_WB) < world_.table_top - 1e-3) {
       ok = false;
-      tally_.Add(Gate::kTable, "'" + world_.tree->nodes[m.moved].name +
-                                   "' would go through the table to reach '" +
-                                   world_.tree->nodes[m.base].name + "' resting as it is");
+      CheckSubject through = about(r0, g0, m.moved, -1);
+      through.hit_table = true;
+      tally_.Add(Gate::kTable,
+                 "'" + world_.tree->nodes[m.moved].name +
+                     "' would go through the table to reach '" + world_.tree->nodes[m.base].name +
+                     "' resting as it is",
+                 through);
     }
     if (ok) {
       const bool m_rests = std::abs(LowestPoint(world_, m.moved, X_WB) - world_.table_top) <= 2e-3;
       const WrenchObject objs[2] = {{m.moved, X_WB, m_rests, mh}, {m.base, X_WB, true, bh}};
       ok = solver_.Wrench(WrenchGate::kAssembly, objs, m.step,
                           AssemblyLpKey(m.step, s.loc[m.base], mh, bh), &why);
-      if (!ok) tally_.Add(Gate::kWrenchAssembly, why);
+      if (!ok) tally_.Add(Gate::kWrenchAssembly, why, about(r0, g0, m.moved, -1));
     }
   } else {
     ok = solver_.AirAssemblyPossible(m.step, mh, bh, key, &why);
-    if (!ok) tally_.Add(Gate::kWrenchAssembly, why);
+    if (!ok) tally_.Add(Gate::kWrenchAssembly, why, about(r0, g0, m.moved, -1));
   }
   Remember(key, ok);
   return ok;
@@ -828,10 +879,20 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   MilestoneResult result;
   const std::string words = "milestone " + std::to_string(index + 1) + " " + StepWords(step);
   if (std::string why; !AssemblyPossible(m, &why)) {
-    result.failure = words +
-                     ": no combination of grasps and supports balances the mating wrench, "
-                     "whatever the robots' reach: " +
-                     why;
+    const std::string reason =
+        "no combination of grasps and supports balances the mating wrench, whatever the "
+        "robots' reach: " +
+        why;
+    result.failure = words + ": " + reason;
+    FailureCase fc;
+    fc.check = std::string(GateName(Gate::kWrenchAssembly));
+    fc.count = 1;
+    fc.text = reason;
+    fc.example = why;
+    fc.object = m.moved;
+    result.start = SceneOf(s0, c0);
+    fc.scene = result.start;
+    result.cases = {std::move(fc)};
     return result;
   }
   const int levels = 3;
@@ -881,6 +942,19 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
       (limits.max_cost < (1 << 30) ? " within " + std::to_string(limits.max_cost) + " actions"
                                    : std::string()) +
       "; " + (abstract_failure.empty() ? tally_.Summary() : abstract_failure);
+  if (abstract_failure.empty()) {
+    Explain(s0, c0, result);
+  } else {
+    FailureCase fc;
+    fc.check = "abstraction";
+    fc.count = 1;
+    fc.text = abstract_failure;
+    fc.example = abstract_failure;
+    fc.object = m.moved;
+    result.start = SceneOf(s0, c0);
+    fc.scene = result.start;
+    result.cases = {std::move(fc)};
+  }
   return result;
 }
 
@@ -920,6 +994,7 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
     result.stopped = status == SearchStatus::kStopped;
     result.out_of_memory = status == SearchStatus::kOutOfMemory;
     result.failure = tally_.Summary();
+    Explain(s0, c0, result);
     return status;
   };
   std::vector<int> path;
@@ -972,7 +1047,12 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
         if (w == witnesses_.end()) {
           auto failed = failed_level_.find(edge);
           const int edge_level = failed == failed_level_.end() ? 0 : failed->second + 1;
+          // The first failure of each collision-like gate in a milestone keeps its picture.
+          solver_.set_explain(tally_.count[static_cast<int>(Gate::kCollision)] == 0 ||
+                              tally_.count[static_cast<int>(Gate::kSkill)] == 0 ||
+                              tally_.count[static_cast<int>(Gate::kApproach)] == 0);
           EdgeOutcome outcome = solver_.Validate(s, c, a, next, edge_level, HashMix(seed_, edge));
+          solver_.set_explain(false);
           if (!outcome.ok) {
             if (std::getenv("WRAP_TASK_DEBUG")) {
               std::fprintf(stderr, "[task]   edge %s r%d r%d obj %d: %s: %s%s\n",
@@ -980,7 +1060,29 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
                            std::string(GateName(outcome.gate)).c_str(), outcome.message.c_str(),
                            outcome.permanent ? " (permanent)" : "");
             }
-            tally_.Add(outcome.gate, outcome.message);
+            CheckSubject about;
+            about.object = a.obj;
+            about.robot = a.type == ActionType::kHandover ? a.r2 : a.r1;
+            about.grasp = a.grasp;
+            about.loc = a.loc;
+            if (a.type == ActionType::kAssemble) {
+              about.object = world_.interface(a.obj).moved;
+              about.robot = -1;
+              for (int r = 0; r < n_robots_ && about.robot < 0; ++r) {
+                if (s.held[r] == about.object) {
+                  about.robot = r;
+                  about.grasp = s.grasp[r];
+                }
+              }
+            }
+            if (about.loc < 0 && about.object >= 0 &&
+                about.object < static_cast<int>(c.X_WA.size())) {
+              about.X_WA = c.X_WA[about.object];
+            }
+            tally_.Add(outcome.gate, outcome.message, about);
+            if (tally_.count[static_cast<int>(outcome.gate)] == 1) {
+              tally_.scene[static_cast<int>(outcome.gate)] = std::move(outcome.scene);
+            }
             failed_level_[edge] = outcome.permanent ? kPermanent : edge_level;
             if (++fill_failures_ > limits.max_failures) return SearchStatus::kExhausted;
             // Optimistic: an assembly with the target's grasps that fails several times is a

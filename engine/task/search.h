@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/run_context.h"
+#include "task/failure.h"
 #include "task/keyframes.h"
 #include "task/planner.h"
 #include "task/state.h"
@@ -22,15 +23,34 @@
 
 namespace wrap {
 
+/// What a failed check was about, for the failure record (FailureCase): ids of the task world
+/// and its tables, -1 where the check names none. Plain data, cheap to pass on every failure.
+struct CheckSubject {
+  int object = -1;           ///< Node id of the object tried.
+  int robot = -1;            ///< Robot that could not reach, or whose gripper hit something.
+  int grasp = -1;            ///< Grasp id (TaskTables) tried.
+  int loc = -1;              ///< Location id where the object was tried.
+  std::optional<Iso3> X_WA;  ///< Or its pose, where it is not a location.
+  int hit_node = -1;         ///< Node the gripper (or the object) hit.
+  bool hit_table = false;    ///< The gripper hit the table.
+};
+
 /// Why edges failed within one milestone, for the report.
 struct GateTally {
   std::array<long long, kNumGates> count{};
   std::array<std::string, kNumGates> example;
-  void Add(Gate gate, const std::string& message);
+  std::array<CheckSubject, kNumGates> subject;  ///< What each example was about.
+  std::array<FailureScene, kNumGates> scene;    ///< The cell each example saw, when captured.
+  void Add(Gate gate, const std::string& message, const CheckSubject& about = {});
   Gate last_gate = Gate::kNone;  ///< Gate of the last Add.
   std::string last_message;      ///< Message of the last Add.
+  CheckSubject last_subject;     ///< Subject of the last Add.
   /// e.g. "wrench (assembly) 120x (e.g. ...), IK 40x (...)".
   std::string Summary(int max_gates = 3) const;
+  /// The gates that failed, most failures first (the order of Summary).
+  std::vector<Gate> Order() const;
+  /// Summary's words for one gate.
+  std::string Words(Gate gate) const;
 };
 
 /// One milestone's answer.
@@ -44,6 +64,9 @@ struct MilestoneResult {
   ContState end_c;             ///< Continuous state at its end.
   bool out_of_memory = false;  ///< Stopped by TaskPlannerOptions::memory_limit_mb.
   std::string failure;         ///< Why not, when !ok.
+  std::vector<FailureCase> cases;  ///< The same as data, blocker first (FailureCase::scene: the
+                                   ///< tried object moved, robots as at the milestone's start).
+  FailureScene start;              ///< The cell at the milestone's start (failure record).
 };
 
 /// Limits of one fill beyond the variant's own, for plan improvement.
@@ -81,6 +104,10 @@ class TaskSearch {
   /// The variant's heuristic of `s` at the start of milestone (`step`, `next_step`), with the
   /// backward abstraction built from `s` at the widest resolution (tests: admissibility).
   int StartHeuristic(int step, int next_step, const SymState& s);
+
+  /// The failure record's cases of the current tally, blocker first, with the scene `start`
+  /// (robots' joints and parts' poses at the milestone's start) and each tried object moved.
+  std::vector<FailureCase> Cases(const FailureScene& start) const;
 
   long long expansions() const { return expansions_; }
   int widenings() const { return widenings_; }
@@ -162,6 +189,12 @@ class TaskSearch {
                          const std::unordered_map<std::uint64_t, bool>& dead_ends,
                          const std::unordered_set<std::uint64_t>& forbidden, long long node_budget,
                          int g0, int max_cost, std::vector<int>& path);
+  /// Fills result.start and result.cases from the current tally (the milestone from (s0, c0)).
+  void Explain(const SymState& s0, const ContState& c0, MilestoneResult& result) const;
+  /// The cell at (s, c) for the failure record: robots' joints, every existing part's pose.
+  FailureScene SceneOf(const SymState& s, const ContState& c) const;
+  /// The failure record's case for one tallied gate.
+  FailureCase Case(Gate gate, const FailureScene& start) const;
   bool CheapPick(int robot, int node, int loc, int grasp);
   bool CheapPlace(int robot, int node, int loc, int grasp);
   bool CheapAssemble(const SymState& s, const Milestone& m);
@@ -223,6 +256,7 @@ class TaskSearch {
     bool ok = true;
     Gate gate = Gate::kNone;
     std::string why;
+    CheckSubject about;
   };
   bool Recall(std::uint64_t key, const CheapAnswer& answer);  // tallies a cached failure once
   void Remember(std::uint64_t key, bool ok);                  // caches with the last tallied reason

@@ -136,6 +136,7 @@ MilestoneResult TaskSearch::FillFlat(const SymState& s0, const ContState& c0) {
         "the whole task (flat, no milestones): no plan with every grasp, placement "
         "and effort level; " +
         tally_.Summary();
+    Explain(s0, c0, result);
   }
   return result;
 }

@@ -199,6 +199,48 @@ TEST(Document, SaveAsRewritesRelativePathsForTheNewFolder) {
   }
 }
 
+TEST(Document, SaveAsKeepsTheUndoHistoryNamingTheSameFiles) {
+  const auto dir = ScratchDir("save_as_undo") / "elsewhere";
+  std::filesystem::create_directories(dir);
+  Document doc = OpenStool();
+  const Project original = doc.project();
+  ASSERT_TRUE(doc.Execute(AddStep("extra")));
+  Part seat = doc.project().parts[0];
+  seat.mass_kg = 0.5;
+  ASSERT_TRUE(doc.Execute(SetPart("seat", seat)));
+  ASSERT_TRUE(doc.SaveAs(dir / "moved.json"));
+  EXPECT_FALSE(doc.dirty());
+  // Both edits can still be undone, and the undone states name the same mesh files from the
+  // new folder.
+  ASSERT_TRUE(doc.CanUndo());
+  EXPECT_NE(doc.UndoLabel().find("seat"), std::string::npos) << doc.UndoLabel();
+  ASSERT_TRUE(doc.Undo());
+  EXPECT_TRUE(doc.dirty());
+  EXPECT_FALSE(doc.project().parts[0].mass_kg.has_value() &&
+               *doc.project().parts[0].mass_kg == 0.5);
+  ASSERT_TRUE(doc.Undo());
+  EXPECT_EQ(doc.project().steps.size(), original.steps.size());
+  EXPECT_FALSE(doc.CanUndo());
+  for (const Part& part : doc.project().parts) {
+    EXPECT_TRUE(std::filesystem::exists(dir / part.mesh)) << part.mesh;
+  }
+  ASSERT_TRUE(doc.Redo());
+  ASSERT_TRUE(doc.Redo());
+  EXPECT_FALSE(doc.dirty()) << "redone back to the state saved as";
+}
+
+TEST(Document, RevisionsAreUniqueAcrossDocuments) {
+  Document a = OpenStool();
+  Document b = OpenStool();
+  Document c;
+  EXPECT_NE(a.revision(), b.revision());
+  EXPECT_NE(b.revision(), c.revision());
+  const unsigned long before = a.revision();
+  ASSERT_TRUE(a.Execute(AddStep("x")));
+  EXPECT_NE(a.revision(), before);
+  EXPECT_NE(a.revision(), b.revision());
+}
+
 TEST(Document, SaveWritesAtomicallyAndLeavesNoTemporaryFile) {
   const auto dir = ScratchDir("atomic");
   Document doc = OpenStool();

@@ -392,3 +392,117 @@ TEST(GuiCli, KilledWhileEditingTheRecoveryFileHoldsTheLastEdit) {
 
 }  // namespace
 }  // namespace wrap::gui
+
+namespace wrap::gui {
+namespace {
+
+// A failed plan, as a user meets it: the Problems panel shows the planner's words (the CLI's),
+// the failing step is marked on the canvas, "Show" selects the part that was tried and puts the
+// viewport into the failing state. Then the live validation lists a warning by entity name, and
+// a negative force typed into the mating editor is refused at the field.
+TEST(GuiCli, AFailedPlanIsExplainedWhereItHappened) {
+  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  const auto dir = ScratchDir("gui_cli_failure");
+  // Only vacuum cups, and the first step needs a transverse force a cup cannot take while
+  // mating: the planner stops at milestone 1 at once (task planner test: VacuumOnly...).
+  std::ofstream(dir / "fail.wrapscript")
+      << "set robot.ur5e_a.end_effector vacuum_cup\n"
+      << "set robot.ur5e_b.end_effector vacuum_cup\n"
+      << "set robot.ur5e_c.end_effector vacuum_cup\n"
+      << "set robot.ur5e_d.end_effector vacuum_cup\n"
+      << "set mating.seat+leg1.transverse_fraction 0.5\n"
+      << "set mating.seat+leg1.offset_m 0.01\n"
+      << "option task_only 1\n"
+      << "screenshot cell.png\n"
+      << "run\n"
+      << "wait\n"
+      << "expect-problem No plan found\n"
+      << "expect-problem balances the mating wrench\n"
+      << "expect-marked seat+leg1\n"
+      << "show 1\n"
+      << "expect-selected part leg1\n"
+      << "expect-selected step seat+leg1\n"
+      << "screenshot shown.png\n"
+      << "show off\n"
+      << "set part.leg4.initial_xyz 1.5 0 0.75\n"
+      << "validate\n"
+      << "expect-problem warning part 'leg4' / initial_pose\n"
+      << "select step seat+leg1\n"
+      << "expect-refused set mating.seat+leg1.force_N -5\n"
+      << "expect-field-error mating.seat+leg1.force_N at least 0\n"
+      << "screenshot refused.png\n";
+  const ProcessRun r = WrapUnderXvfb(
+      dir, "'" + ExampleProject("stool").string() + "' --script fail.wrapscript --size 1400x900");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("ok 25: screenshot refused.png"), std::string::npos) << r.output;
+  // Show: the viewport changed (the tried part highlighted amber, the scene as the check saw it).
+  auto cell = render::ReadPng(dir / "cell.png");
+  auto shown = render::ReadPng(dir / "shown.png");
+  auto refused = render::ReadPng(dir / "refused.png");
+  ASSERT_TRUE(cell && shown && refused);
+  const PixelDiff show = Diff(*cell, *shown, 340, 60, 1010, 560);
+  EXPECT_GT(show.pixels, 300) << "the failing state is drawn";
+  // The refusal is written at the field, in the mating panel (right column, middle): red text.
+  const RegionStats mating = Stats(*refused, 1030, 400, 1395, 640, {255, 115, 102});
+  EXPECT_GT(mating.near_colour, 20) << "the refusal's red text under the force field";
+}
+
+// No stale picture: File > New draws the empty cell (as a GUI started without a project does);
+// an edit marks the plan out of date (not played as current) and undo makes it current again;
+// Save As keeps the undo history.
+TEST(GuiCli, NewAndEditsNeverShowAStalePicture) {
+  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  const auto dir = ScratchDir("gui_cli_stale");
+  std::ofstream(dir / "empty.wrapscript") << "expect-viewport empty\nscreenshot empty.png\n";
+  const ProcessRun e = WrapUnderXvfb(dir, "--script empty.wrapscript --size 1400x900");
+  ASSERT_EQ(e.code, 0) << e.output;
+  std::ofstream(dir / "stale.wrapscript") << "option task_only 1\n"
+                                          << "run\n"
+                                          << "wait\n"
+                                          << "expect-plan\n"
+                                          << "expect-plan-current\n"
+                                          << "scrub 2\n"
+                                          << "screenshot current.png\n"
+                                          << "set part.leg1.initial_xyz 0.12 0.2 0.47\n"
+                                          << "expect-plan-stale\n"
+                                          << "screenshot stale.png\n"
+                                          << "undo\n"
+                                          << "expect-plan-current\n"
+                                          << "set part.seat.mass_kg 0.3\n"
+                                          << "save elsewhere/moved.json\n"
+                                          << "expect-undo seat\n"
+                                          << "undo\n"
+                                          << "save\n"
+                                          << "expect-viewport cell\n"
+                                          << "new\n"
+                                          << "expect-viewport empty\n"
+                                          << "screenshot new.png\n";
+  fs::create_directories(dir / "elsewhere");
+  const ProcessRun r = WrapUnderXvfb(dir, "'" + ExampleProject("half_stool").string() +
+                                              "' --script stale.wrapscript --size 1400x900");
+  ASSERT_EQ(r.code, 0) << r.output;
+  // New: the viewport as without a project (the empty cell), not the half stool's.
+  auto empty = render::ReadPng(dir / "empty.png");
+  auto fresh = render::ReadPng(dir / "new.png");
+  auto current = render::ReadPng(dir / "current.png");
+  auto stale = render::ReadPng(dir / "stale.png");
+  ASSERT_TRUE(empty && fresh && current && stale);
+  const PixelDiff same = Diff(*empty, *fresh, 340, 60, 1010, 560);
+  EXPECT_LT(same.pixels, 0.01 * 670 * 500) << "New draws the empty cell";
+  const PixelDiff cell = Diff(*current, *fresh, 340, 60, 1010, 560);
+  EXPECT_GT(cell.pixels, 0.05 * 670 * 500) << "... which differs from the half stool's";
+  // Out of date: the lanes are grey (no orange assemble bars), the plan is not shown as current.
+  EXPECT_GT(Stats(*current, 330, 600, 1010, 880, {230, 140, 50}).near_colour, 100);
+  EXPECT_LT(Stats(*stale, 330, 600, 1010, 880, {230, 140, 50}).near_colour, 20);
+  // Save As then undo: the saved file holds the undone state, its meshes found from its folder.
+  auto saved = Document::Open(dir / "elsewhere/moved.json");
+  ASSERT_TRUE(saved) << saved.error().message;
+  EXPECT_FALSE(saved->project().parts[0].mass_kg.has_value() &&
+               *saved->project().parts[0].mass_kg == 0.3);
+  for (const Part& part : saved->project().parts) {
+    EXPECT_TRUE(fs::exists(dir / "elsewhere" / part.mesh)) << part.mesh;
+  }
+}
+
+}  // namespace
+}  // namespace wrap::gui

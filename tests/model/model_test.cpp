@@ -9,6 +9,7 @@
 #include "core/file_io.h"
 #include "geometry/mesh_export.h"
 #include "model/catalog.h"
+#include "model/entity_path.h"
 #include "model/paths.h"
 #include "model/project_io.h"
 #include "model/validate.h"
@@ -496,6 +497,39 @@ INSTANTIATE_TEST_SUITE_P(Projects, ExampleProject,
                          ::testing::Values("stool", "chair", "cross", "cross_openarm", "cube",
                                            "cube_2x2x3", "half_stool", "fabrica_beam",
                                            "fabrica_plumbers_block", "fabrica_car"));
+
+TEST(EntityPath, NamesTheEntityAJsonPathPointsAt) {
+  Project p;
+  p.parts.push_back(Part{});
+  p.parts[0].name = "seat";
+  p.parts.push_back(Part{});
+  p.parts[1].name = "leg1";
+  p.steps.push_back(Step{});
+  p.steps[0].name = "seat+leg1";
+  p.robots.push_back(Robot{});
+  p.robots[0].name = "ur5e_a";
+  const EntityRef leg = EntityOfPath(p, "parts[1].initial_pose");
+  EXPECT_EQ(leg.kind, EntityKind::kPart);
+  EXPECT_EQ(leg.name, "leg1");
+  EXPECT_EQ(leg.field, "initial_pose");
+  EXPECT_EQ(leg.Label(), "part 'leg1'");
+  const EntityRef force = EntityOfPath(p, "steps[0].mating.force_N");
+  EXPECT_EQ(force.kind, EntityKind::kStep);
+  EXPECT_EQ(force.name, "seat+leg1");
+  EXPECT_EQ(force.field, "mating.force_N");
+  EXPECT_EQ(EntityOfPath(p, "robots[0]").Label(), "robot 'ur5e_a'");
+  EXPECT_EQ(EntityOfPath(p, "robots[0]").field, "");
+  EXPECT_EQ(EntityOfPath(p, "table.friction").kind, EntityKind::kTable);
+  EXPECT_EQ(EntityOfPath(p, "table.friction").field, "friction");
+  EXPECT_EQ(EntityOfPath(p, "planner.seed").kind, EntityKind::kPlanner);
+  EXPECT_EQ(EntityOfPath(p, "").kind, EntityKind::kProject);
+  // An index beyond the lists, or a malformed one: the path itself, nothing selected.
+  const EntityRef beyond = EntityOfPath(p, "parts[7].mesh");
+  EXPECT_EQ(beyond.kind, EntityKind::kOther);
+  EXPECT_EQ(beyond.field, "parts[7].mesh");
+  EXPECT_EQ(EntityOfPath(p, "parts[x].mesh").kind, EntityKind::kOther);
+  EXPECT_EQ(EntityOfPath(p, "connection_limits.force_N").kind, EntityKind::kProject);
+}
 
 }  // namespace
 }  // namespace wrap

@@ -462,6 +462,32 @@ TEST(Motion, TheSelfCheckRefusesTrajectoriesThatCollide) {
   EXPECT_TRUE(checked.trajectories.empty());
 }
 
+// A motion that cannot be made says where (the action, the segment) and carries the cell where
+// it happened (every robot's joints, every part's pose), for the GUI's Show: no arm backs its
+// gripper straight away from a grasp by half a metre or more.
+TEST(Motion, AFailureCarriesTheCellWhereItHappened) {
+  const Planned& p = PlanOnce("half_stool");
+  ASSERT_TRUE(p.error.empty()) << p.error;
+  MotionOptions options;
+  options.approach_m = 5.0;
+  Plan plan = *p.plan;
+  plan.trajectories.clear();
+  plan.segments.clear();
+  for (PlanAction& a : plan.actions) a.start_s = a.end_s = -1.0;
+  MotionCache cache;
+  RunContext ctx(1);
+  auto attempt = PlanMotion(*p.world, plan, options, 0, 3, cache, ctx);
+  ASSERT_TRUE(attempt.has_value()) << attempt.error().message;
+  ASSERT_FALSE(attempt->solved);
+  const MotionFailure& f = attempt->failure;
+  EXPECT_GE(f.action, 0);
+  EXPECT_LT(f.action, static_cast<int>(plan.actions.size()));
+  EXPECT_FALSE(f.segment.empty());
+  EXPECT_EQ(f.scene.q.size(), plan.robots.size());
+  EXPECT_EQ(f.scene.X_WP.size(), plan.parts.size());
+  for (const JointVector& q : f.scene.q) EXPECT_GT(q.size(), 0);
+}
+
 TEST(Motion, PlanJsonKeepsTheTrajectories) {
   const Planned& p = PlanOnce("stool");
   ASSERT_TRUE(p.error.empty() && p.plan->stats.solved);

@@ -261,6 +261,79 @@ TEST(PlannerInfeasible, VacuumOnlyTransverseForceNamesTheStep) {
       << run.plan->stats.failure;
   EXPECT_NE(run.plan->stats.failure.find("mating wrench"), std::string::npos)
       << run.plan->stats.failure;
+  // The same as data: the task stage, the step, the check, the moved input, the cell.
+  ASSERT_TRUE(run.plan->stats.failure_detail.has_value());
+  const PlanFailure& f = *run.plan->stats.failure_detail;
+  EXPECT_EQ(f.stage, "task");
+  EXPECT_EQ(f.text, run.plan->stats.failure);
+  ASSERT_GE(f.step, 0);
+  ASSERT_LT(f.step, static_cast<int>(run.plan->nodes.size()));
+  EXPECT_EQ(run.plan->nodes[f.step], "seat+leg1");
+  ASSERT_EQ(f.cases.size(), 1u);
+  EXPECT_EQ(f.cases[0].check, "wrench (assembly)");
+  EXPECT_NE(f.text.find(f.cases[0].text), std::string::npos) << "the CLI's words";
+  ASSERT_GE(f.cases[0].object, 0);
+  EXPECT_EQ(run.plan->nodes[f.cases[0].object], project.steps[0].mating.moved);
+  EXPECT_EQ(f.start.q.size(), project.robots.size()) << "every robot's joints";
+  EXPECT_EQ(f.start.X_WP.size(), project.parts.size()) << "every part's pose";
+}
+
+// A leg beyond every robot's reach, planned with the counting heuristic (no backward abstraction
+// to answer first): the search tries every way and the report's checks come as data, blocker
+// first, each naming what it tried (the object where it was tried, the robot, the grasp) with
+// the cell at it; a gripper put into the table names the gripper and the table.
+TEST(PlannerInfeasible, TheReportsChecksSayWhatWasTried) {
+  const fs::path file = ProjectFile("half_stool");
+  const LoadedProject lp = LoadProject(file);
+  ASSERT_TRUE(lp.ok());
+  Project project = *lp.project;
+  project.parts.back().initial_pose.xyz.head<2>() = Eigen::Vector2d(1.6, -1.6);
+  const ProjectCheck check = ValidateProject(project, file);
+  ASSERT_FALSE(check.diagnostics.has_errors());
+  auto pre = PreprocessProject(LoadedProject{project, check}, file);
+  ASSERT_TRUE(pre.has_value()) << pre.error().message;
+  TaskPlannerOptions options;
+  options.planner = "counting";
+  options.project_file = file;
+  RunContext ctx(0);
+  ctx.set_time_limit_s(120.0);
+  auto plan = PlanTask(project, check, *pre, options, ctx);
+  ASSERT_TRUE(plan.has_value()) << plan.error().message;
+  ASSERT_FALSE(plan->stats.solved);
+  ASSERT_TRUE(plan->stats.failure_detail.has_value()) << plan->stats.failure;
+  const PlanFailure& f = *plan->stats.failure_detail;
+  EXPECT_EQ(f.stage, "task");
+  EXPECT_EQ(f.text, plan->stats.failure);
+  ASSERT_GE(f.step, 0);
+  EXPECT_EQ(plan->nodes[f.step], "half_stool");
+  ASSERT_FALSE(f.cases.empty()) << f.text;
+  EXPECT_LE(f.cases.size(), 3u) << "the checks the report's words name";
+  bool table_named = false;
+  for (size_t i = 0; i < f.cases.size(); ++i) {
+    const FailureCase& c = f.cases[i];
+    if (i > 0) EXPECT_GE(f.cases[i - 1].count, c.count) << "blocker first";
+    EXPECT_NE(f.text.find(c.text), std::string::npos) << c.text << " in " << f.text;
+    EXPECT_EQ(c.scene.X_WP.size(), project.parts.size()) << c.check;
+    EXPECT_EQ(c.scene.q.size(), project.robots.size()) << c.check;
+    if (c.check == "collision" && c.example.find("into the table") != std::string::npos) {
+      ASSERT_GE(c.object, 0);
+      EXPECT_NE(c.example.find(plan->nodes[c.object]), std::string::npos) << c.example;
+      EXPECT_GE(c.robot, 0);
+      EXPECT_GE(c.grasp_part, 0);
+      ASSERT_TRUE(c.X_WA.has_value());
+      // The object is drawn where it was tried, every part of it.
+      for (int p = 0; p < static_cast<int>(project.parts.size()); ++p) {
+        const auto& parts = lp.check.tree->nodes[c.object].parts;
+        if (std::find(parts.begin(), parts.end(), p) == parts.end()) continue;
+        const Iso3 X_AP = ToIsometry(project.parts[p].assembled_pose);
+        EXPECT_LT((c.scene.X_WP[p].translation() - (*c.X_WA * X_AP).translation()).norm(), 1e-9);
+      }
+      EXPECT_NE(std::find(c.scene.bodies.begin(), c.scene.bodies.end(), "table"),
+                c.scene.bodies.end());
+      table_named = true;
+    }
+  }
+  EXPECT_TRUE(table_named) << "a gripper into the table among the checks: " << f.text;
 }
 
 // Without the wrench model the same project plans (the failure above is the wrench's).

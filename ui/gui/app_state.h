@@ -3,20 +3,24 @@
 #pragma once
 
 #include <deque>
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "gui/document.h"
 #include "gui/planner_job.h"
+#include "gui/validation_job.h"
 #include "render/window_renderer.h"
 #include "task/plan.h"
 
 namespace wrap::gui {
 
-using render::SceneArrow;
-using render::SceneMarker;
 using render::DrawQuality;
+using render::SceneArrow;
+using render::SceneHighlight;
+using render::SceneMarker;
 using render::ViewportRenderer;
 
 /// What is selected, shared by the viewport, the DAG canvas and the editors.
@@ -45,18 +49,41 @@ enum class QualityMode {
 /// Frame times of the recent frames, for the frame rate shown and reported.
 class FrameStats {
  public:
-  /// Records one frame's duration [s].
-  void Add(double seconds);
+  /// Records one frame that ended at `now` [s] and took `seconds` from the previous one.
+  void Add(double seconds, double now = 0.0);
   /// Median frame rate over the recent frames [1/s] (0 before any frame).
   double MedianFps() const;
+  /// Frames drawn per second over the last second before `now` (what the eye sees: a burst of
+  /// quick frames after an input does not read as thousands per second) [1/s].
+  double RecentFps(double now) const;
   /// Forgets the recorded frames.
-  void Clear() { seconds_.clear(); }
+  void Clear() {
+    seconds_.clear();
+    ends_.clear();
+  }
   size_t size() const { return seconds_.size(); }
 
  private:
   std::deque<double> seconds_;  // the last kKept
+  std::deque<double> ends_;     // when each of them ended
   static constexpr size_t kKept = 60;
 };
+
+/// The last planner run that found no plan, as the Problems panel shows it: the CLI's words and
+/// the failure record, with the names of the project as it was planned (the document may have
+/// changed since).
+struct RunFailure {
+  std::string headline;  ///< The CLI's line, e.g. "No plan found in 12.3 s: milestone 2/4 ...".
+  std::shared_ptr<const PlanFailure> failure;        ///< The record (null: the run failed earlier).
+  std::shared_ptr<const Project> project;            ///< The project as planned.
+  std::vector<std::string> nodes;                    ///< DAG node names by node id (parts, steps).
+  std::vector<std::vector<std::string>> node_parts;  ///< Part names of each node.
+  /// The step the failure is about (a name of `project`), or "".
+  std::string StepName() const;
+};
+
+/// How the viewport's gizmo edits the selected part's or robot's pose.
+enum class GizmoMode { kTranslate, kRotate };
 
 /// Green at no load, through yellow (70%), to red at the limit and beyond (r, g, b in [0, 1]).
 Rgba UtilisationColour(double utilisation);
@@ -69,6 +96,20 @@ struct AppState {
   PlannerRequest request;                  ///< Options of the next run.
   std::shared_ptr<const Plan> plan;        ///< The plan on show (null: none).
   std::string plan_origin;                 ///< Where it came from ("planned", a file name).
+  /// The project the plan was made for (the run's snapshot, or the document when a plan file
+  /// was opened): the plan is current while the document equals it, else out of date.
+  std::shared_ptr<const Project> plan_project;
+  std::optional<RunFailure> run_failure;  ///< The last run's failure (none after a solve).
+  std::vector<std::string> run_warnings;  ///< The last run's preprocessing warnings.
+  int showing_case = -1;      ///< Failure case the viewport shows ("Show"), -1: the cell as it is.
+  LiveValidation validation;  ///< Checks the document after each edit.
+  /// Out-of-range values typed into fields, by field key (e.g. "mating.seat+leg1.force_N"):
+  /// the message shown under the field; cleared by the next valid value.
+  std::map<std::string, std::string> field_errors;
+  std::map<std::string, JointVector> jog;   ///< Robot name -> joints set with its sliders.
+  GizmoMode gizmo = GizmoMode::kTranslate;  ///< The viewport gizmo's mode.
+  bool focus_problems = false;              ///< Bring the Problems tab to the front once.
+  std::string canvas_marked;  ///< Step the DAG canvas drew as failing in the last frame ("").
   Playback playback;                       ///< Timeline.
   ViewportRenderer viewport;               ///< The cell in the viewport.
   unsigned long viewport_revision = ~0ul;  ///< Document revision the cell was built from.
@@ -78,6 +119,10 @@ struct AppState {
   QualityMode quality = QualityMode::kAuto;  ///< Viewport drawing quality.
   bool show_utilisation = true;  ///< Tint grippers by wrench utilisation during playback.
   FrameStats frames;                       ///< Recent frame times.
+
+  /// True when a plan is on show and the document has changed since it was made (a plan for
+  /// another project state: shown greyed, not played as current).
+  bool PlanStale() const;
 
   /// Adds a message (kept: the last 200).
   void Notify(std::string message) {

@@ -1,5 +1,6 @@
 #include "gui/document.h"
 
+#include <atomic>
 #include <system_error>
 
 #include "core/file_io.h"
@@ -9,12 +10,21 @@ namespace wrap::gui {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// Revisions are unique across documents: a new or opened document never repeats the revision
+// of the one it replaces, so whatever was derived from that one (the viewport's cell) is redone.
+std::atomic<unsigned long> g_revision{0};
+
+}  // namespace
+
 Document::Document() : Document(Project{}, {}) {}
 
 Document::Document(Project project, fs::path path) : path_(std::move(path)) {
   history_.push_back(Entry{std::move(project), "", "", 0});
   saved_id_ = 0;
   recovered_id_ = 0;
+  revision_ = ++g_revision;
 }
 
 Result<Document> Document::Open(const fs::path& path) {
@@ -56,7 +66,7 @@ Result<void> Document::Execute(const Command& command) {
     ++current_;
   }
   merge_open_ = !command.merge_key.empty();
-  ++revision_;
+  revision_ = ++g_revision;
   return {};
 }
 
@@ -64,7 +74,7 @@ bool Document::Undo() {
   if (!CanUndo()) return false;
   --current_;
   merge_open_ = false;
-  ++revision_;
+  revision_ = ++g_revision;
   return true;
 }
 
@@ -72,7 +82,7 @@ bool Document::Redo() {
   if (!CanRedo()) return false;
   ++current_;
   merge_open_ = false;
-  ++revision_;
+  revision_ = ++g_revision;
   return true;
 }
 
@@ -99,15 +109,14 @@ Result<void> Document::SaveAs(const fs::path& path) {
   RebasePaths(moved, from_dir, to_dir);
   if (auto saved = SaveProject(moved, path); !saved) return saved;
   RemoveRecovery();
-  // The rebased project is what the file holds: it becomes the clean state. Paths change
-  // meaning with the folder, so the history before cannot be undone into the new folder.
+  // The rebased project is what the file holds: it becomes the clean state. Every state of the
+  // history moves with the file (its relative paths rewritten the same way), so undo and redo
+  // after Save As name the same files as before it.
   path_ = path;
-  history_.clear();
-  history_.push_back(Entry{std::move(moved), "", "", next_id_++});
-  current_ = 0;
-  saved_id_ = history_[0].id;
+  for (Entry& e : history_) RebasePaths(e.project, from_dir, to_dir);
+  saved_id_ = history_[current_].id;
   merge_open_ = false;
-  ++revision_;
+  revision_ = ++g_revision;
   return {};
 }
 

@@ -67,15 +67,17 @@ class Document {
   /// True when the project differs from the file (an edit since the last save or open, and not
   /// undone back to it).
   bool dirty() const { return history_[current_].id != saved_id_; }
-  /// Increases with every change of the project (edit, undo, redo): panels that cache what they
-  /// derive from the project compare it.
+  /// Changes with every change of the project (edit, undo, redo), and is unique across
+  /// documents (a new or opened document has a revision no other had): panels that cache what
+  /// they derive from the project compare it.
   unsigned long revision() const { return revision_; }
 
   /// Saves to path() atomically and marks the document clean; removes the recovery file.
   /// Fails with kInvalidInput when untitled, kIo when the file cannot be written.
   Result<void> Save();
   /// Saves to `path` (then the document's file): relative mesh and URDF paths are rewritten
-  /// relative to the new folder so they still name the same files.
+  /// relative to the new folder so they still name the same files, in every state of the undo
+  /// history too (undo after Save As works, and names the same files).
   Result<void> SaveAs(const std::filesystem::path& path);
 
   /// The recovery file of this document: beside the project, "<file>.recovery"; for an untitled

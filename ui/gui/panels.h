@@ -8,6 +8,7 @@
 #include <imgui.h>
 
 #include "gui/app_state.h"
+#include "model/entity_path.h"
 
 namespace wrap::gui {
 
@@ -40,27 +41,40 @@ struct PartsPanel {
   void Draw(AppState& app, const PanelRect& r);
 };
 
-/// The assembly DAG as a node canvas: parts and steps, drag from a node's port onto a step to
-/// make an input, right-click an edge to remove it, automatic layout.
+/// The assembly DAG as a node canvas: parts and steps with their full names, drag from a node's
+/// out port (yellow) onto a step to make an input, right-click an edge to remove it, automatic
+/// layout that keeps every node in view (fit to view; wheel zooms, middle drag pans), hover a step
+/// for its mating; the step where the last run failed is marked red.
 struct GraphPanel {
   std::map<std::string, ImVec2> pos;   ///< Node positions on the canvas (canvas units).
+  std::map<std::string, float> width;  ///< Node widths from their names (canvas units).
   std::string drag_from;               ///< Node a link is dragged from ("" none).
   std::string moving;                  ///< Node being moved.
   std::string new_step_name = "step";  ///< Name field of "New step".
   std::string rename_to;               ///< Rename field.
+  std::string renaming;                ///< Step the rename field was filled for.
   ImVec2 scroll{20, 20};               ///< Canvas offset [px].
+  float zoom = 1.0f;                   ///< Canvas pixels per canvas unit.
+  bool fit_pending = true;             ///< Fit the whole graph into view at the next draw.
   std::string signature;               ///< Nodes and edges the layout was made for.
   float canvas_width = 400.0f;         ///< Width of the canvas last drawn [px].
-  /// Places every node: parts in column 0, each step one column right of its deepest input,
-  /// the columns fitted to the canvas width.
+  float canvas_height = 300.0f;        ///< Height of the canvas last drawn [px].
+  std::string marked;                  ///< Node drawn as failing this frame ("" none).
+  bool vertical = false;               ///< Levels as rows (flow downwards), else as columns.
+  /// Places every node by level (a step one past its deepest input, a part one before the step
+  /// that uses it), levels as columns or as rows, whichever shows the whole graph larger in the
+  /// canvas; every node as wide as its name, none overlapping; then fits the view.
   void AutoLayout(const Project& project);
+  /// Zoom and scroll that show every node inside the canvas (zoom at most 1).
+  void FitToView();
   /// The nodes and edges of `project` as a string: the layout is redone when it changes.
   static std::string Signature(const Project& project);
   void Draw(AppState& app, const PanelRect& r);
 };
 
 /// The selected step's mating: moved and base input, insertion axis, force and torque,
-/// uncertainty, approach, final poses, connection limits.
+/// uncertainty, approach, final poses, connection limits; each field with a tooltip (meaning,
+/// unit) and its range enforced (an out-of-range value is refused with a message at the field).
 struct MatingPanel {
   void Draw(AppState& app, const PanelRect& r);
 };
@@ -68,6 +82,8 @@ struct MatingPanel {
 /// Robots: add from the catalog, remove, base pose, end effector, wrench-limit tables.
 struct RobotsPanel {
   int add_model = 0;  ///< Index into RobotModels().
+  /// Joint sliders of the selected robot (jogging: the viewport shows it there; not saved).
+  void JointSliders(AppState& app, const std::string& robot);
   int add_ee = 0;     ///< Index into EndEffectors().
   std::string urdf_path, urdf_root, urdf_tip;  ///< Fields of "Add from URDF".
   FileBrowser browser;                         ///< URDF files.
@@ -77,23 +93,45 @@ struct RobotsPanel {
   void Draw(AppState& app, const PanelRect& r);
 };
 
-/// Planner options, Run / Cancel, progress, log, errors.
+/// Planner options, Run / Cancel, progress through every stage (its name and count), log, errors.
 struct PlannerPanel {
   void Draw(AppState& app, const PanelRect& r);
 };
 
+/// Starts the planner on the document with the request's options (Run, Re-plan).
+void StartRun(AppState& app);
+
 /// The plan: actions in words (click to jump), timeline with play/pause/speed/loop and a
-/// scrubber, per-robot lanes.
+/// scrubber, per-robot lanes; a plan of another state of the project greyed, with "Re-plan".
+/// Drawn as a tab of the bottom panel.
 struct PlanPanel {
-  void Draw(AppState& app, const PanelRect& r);
+  void Contents(AppState& app);
 };
 
+/// The Problems tab: the last run's failure (the CLI's words, blocker first, "Show" per failed
+/// check) and the live validation's diagnostics by entity name (click: select).
+struct ProblemsPanel {
+  /// "Problems (no plan, 1 error, 2 warnings)".
+  static std::string Title(const AppState& app);
+  void Contents(AppState& app);
+};
+
+/// Puts the viewport into failure case `index` of the last run (-1: back to the cell) and
+/// selects what failed: the object's part, the robot, the step.
+void ShowFailureCase(AppState& app, int index);
+/// Selects the part, step or robot `entity` names (others: nothing).
+void SelectEntity(AppState& app, const EntityRef& entity);
+
 /// The viewport: the cell drawn by MuJoCo under a transparent ImGui window; mouse orbit (left),
-/// pan (right or middle), zoom (wheel), click to select a part, reset view.
+/// pan (right or middle), zoom (wheel), click to select a part, shift+drag moves the selected
+/// part on the table, a translate/rotate gizmo on the selected part or robot base; reset view.
 struct ViewportPanel {
-  PanelRect rect;         ///< Where the cell was drawn this frame (window coordinates).
-  bool dragging = false;  ///< A camera drag is under way.
-  ImVec2 press{0, 0};     ///< Where the mouse went down.
+  PanelRect rect;      ///< Where the cell was drawn this frame (window coordinates).
+  ImVec2 press{0, 0};  ///< Where the mouse went down.
+  /// What the drag under way does, decided when the mouse went down: a drag that starts with
+  /// shift held on a selected part moves it until the button is released, whatever the keys.
+  enum class Drag { kNone, kCamera, kMovePart, kGizmo } drag = Drag::kNone;
+  int gizmo_axis = -1;  ///< Gizmo handle being dragged (0-2 move x/y/z, 3-5 turn about x/y/z).
   void Draw(AppState& app, const PanelRect& r);
 };
 

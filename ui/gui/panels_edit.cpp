@@ -8,8 +8,10 @@
 #include <numbers>
 
 #include "gui/commands.h"
+#include "gui/fields.h"
 #include "gui/panels.h"
 #include "model/catalog.h"
+#include "robot/kinematics.h"
 
 namespace wrap::gui {
 
@@ -41,17 +43,18 @@ bool EditPose(const char* id, Pose& pose) {
   return changed;
 }
 
-bool EditDouble(const char* label, double& v, float speed, const char* format, double lo = 0.0,
-                double hi = 0.0) {
-  const bool bounded = hi > lo;
-  return ImGui::DragScalar(label, ImGuiDataType_Double, &v, speed, bounded ? &lo : nullptr,
-                           bounded ? &hi : nullptr, format);
-}
-
-bool EditBox(const char* id, WrenchBox& box) {
+/// A wrench box (force and torque limits per axis) with its fields' ranges and tooltips;
+/// `kind` "limits" (a gripper's) or "connection" (a mating's T_pq); `key` names it for refusals.
+bool EditBox(AppState& app, const char* id, const std::string& key, WrenchBox& box,
+             bool connection) {
   ImGui::PushID(id);
-  bool changed = EditVec3("force [N]", box.force_N, 0.1f, "%.1f");
-  changed |= EditVec3("torque [N m]", box.torque_Nm, 0.01f, "%.2f");
+  const FieldSpec& force =
+      connection ? *FindField("mating", "connection_force_N") : *FindField("limits", "force_N");
+  const FieldSpec& torque =
+      connection ? *FindField("mating", "connection_torque_Nm") : *FindField("limits", "torque_Nm");
+  bool changed = RangedVec3(app, force, key + ".force_N", "force [N]", box.force_N, 0.1f, "%.1f");
+  changed |=
+      RangedVec3(app, torque, key + ".torque_Nm", "torque [N m]", box.torque_Nm, 0.01f, "%.2f");
   ImGui::PopID();
   return changed;
 }
@@ -131,8 +134,10 @@ void PartsPanel::Draw(AppState& app, const PanelRect& r) {
     CloseMergeOnRelease(app);
     Table table = p.table;
     bool t = EditVec3("table size [m]", table.size, 0.01f, "%.2f");
-    t |= EditDouble("table height [m]", table.height, 0.005f, "%.3f");
-    t |= EditDouble("friction", table.friction, 0.01f, "%.2f", 0.0, 2.0);
+    t |= RangedDouble(app, *FindField("table", "height"), "table.height", table.height, 0.005f,
+                      "%.3f");
+    t |= RangedDouble(app, *FindField("table", "friction"), "table.friction", table.friction, 0.01f,
+                      "%.2f");
     if (t) app.Do(SetTable(table, "table"));
     CloseMergeOnRelease(app);
   }
@@ -183,16 +188,19 @@ void PartsPanel::Draw(AppState& app, const PanelRect& r) {
         }
         ImGui::TextDisabled("mesh: %s", part.mesh.c_str());
         bool changed = false;
-        changed |= EditDouble("scale [m/unit]", part.scale, 0.0001f, "%.4g", 1e-6, 100.0);
+        changed |= RangedDouble(app, *FindField("part", "scale"), key + "scale", part.scale,
+                                0.0001f, "%.4g");
         bool has_mass = part.mass_kg.has_value();
         if (ImGui::Checkbox("given mass", &has_mass)) {
           part.mass_kg = has_mass ? std::optional<double>(0.1) : std::nullopt;
           changed = true;
         }
         if (part.mass_kg) {
-          changed |= EditDouble("mass [kg]", *part.mass_kg, 0.001f, "%.3f", 1e-6, 1e4);
+          changed |= RangedDouble(app, *FindField("part", "mass_kg"), key + "mass_kg",
+                                  *part.mass_kg, 0.001f, "%.3f");
         } else {
-          changed |= EditDouble("density [kg/m3]", part.density_kg_m3, 1.0f, "%.0f", 1.0, 1e5);
+          changed |= RangedDouble(app, *FindField("part", "density_kg_m3"), key + "density_kg_m3",
+                                  part.density_kg_m3, 1.0f, "%.0f");
         }
         float c[4] = {static_cast<float>(part.color[0]), static_cast<float>(part.color[1]),
                       static_cast<float>(part.color[2]), static_cast<float>(part.color[3])};
@@ -242,20 +250,44 @@ void MatingPanel::Draw(AppState& app, const PanelRect& r) {
     }
   };
   pick("moved input", m.moved);
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip("The input the robots bring to the other one along the insertion axis.");
+  }
   pick("base input", m.base);
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip("The input that stays: held by robots, or resting on the table.");
+  }
   if (ImGui::SmallButton("Swap moved and base")) {
     std::swap(m.moved, m.base);
     changed = true;
   }
-  changed |= EditVec3("insertion axis", m.axis, 0.01f, "%.2f");
+  const std::string key = "mating." + step.name + ".";
+  changed |= RangedVec3(app, *FindField("mating", "axis"), key + "axis", "insertion axis", m.axis,
+                        0.01f, "%.2f");
   ImGui::SameLine();
   ImGui::TextDisabled("(assembly frame)");
-  changed |= EditDouble("force [N]", m.force_N, 0.1f, "%.1f", 0.0, 1e4);
-  changed |= EditDouble("torque [N m]", m.torque_Nm, 0.01f, "%.2f", -1e3, 1e3);
-  changed |= EditDouble("transverse fraction", m.transverse_fraction, 0.005f, "%.3f", 0.0, 1.0);
-  changed |= EditDouble("offset [m]", m.offset_m, 0.0005f, "%.4f", 0.0, 1.0);
-  changed |= EditDouble("approach [m]", m.approach_m, 0.001f, "%.3f", 0.0, 1.0);
+  struct NumberField {
+    const char* name;
+    double* value;
+    float speed;
+    const char* format;
+  };
+  for (const NumberField& f :
+       {NumberField{"force_N", &m.force_N, 0.1f, "%.1f"},
+        NumberField{"torque_Nm", &m.torque_Nm, 0.01f, "%.2f"},
+        NumberField{"transverse_fraction", &m.transverse_fraction, 0.005f, "%.3f"},
+        NumberField{"offset_m", &m.offset_m, 0.0005f, "%.4f"},
+        NumberField{"approach_m", &m.approach_m, 0.001f, "%.3f"}}) {
+    changed |=
+        RangedDouble(app, *FindField("mating", f.name), key + f.name, *f.value, f.speed, f.format);
+  }
   ImGui::Text("final poses: %s", m.final_poses.empty() ? "from the assembled poses" : "");
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip(
+        "Valid final poses of the moved input relative to the base (symmetric parts have\n"
+        "several), xyz [m] and roll-pitch-yaw [deg] in the assembly frame; none: the parts'\n"
+        "assembled poses.");
+  }
   for (size_t i = 0; i < m.final_poses.size(); ++i) {
     ImGui::PushID(static_cast<int>(i));
     changed |= EditPose("final", m.final_poses[i]);
@@ -276,10 +308,56 @@ void MatingPanel::Draw(AppState& app, const PanelRect& r) {
     m.connection_limits = own_limits ? std::optional<WrenchBox>(p.connection_limits) : std::nullopt;
     changed = true;
   }
-  if (m.connection_limits) changed |= EditBox("limits", *m.connection_limits);
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip(
+        "T_pq: the wrench the new connection sustains once made (a box in the mating frame);\n"
+        "off: the project's default connection limits.");
+  }
+  if (m.connection_limits) {
+    changed |= EditBox(app, "limits", key + "connection", *m.connection_limits, true);
+  }
   if (changed) app.Do(SetMating(step.name, m, "mating:" + step.name));
   if (!ImGui::IsAnyItemActive()) app.doc.CloseMerge();
   ImGui::End();
+}
+
+void RobotsPanel::JointSliders(AppState& app, const std::string& name) {
+  if (!app.viewport.ready()) return;
+  const CellScene& scene = app.viewport.scene();
+  auto it = std::find_if(scene.robots.begin(), scene.robots.end(),
+                         [&](const SceneRobot& r) { return r.name == name; });
+  if (it == scene.robots.end()) return;
+  const SceneRobot& robot = *it;
+  if (!ImGui::TreeNode("Joints (jog)")) return;
+  JointVector q =
+      app.jog.count(name) && app.jog[name].size() == robot.home.size() ? app.jog[name] : robot.home;
+  bool changed = false;
+  for (size_t j = 0; j < robot.chain.joints.size() && static_cast<long>(j) < q.size(); ++j) {
+    const Joint& joint = robot.chain.joints[j];
+    const bool revolute = joint.type == Joint::Type::kRevolute;
+    double v = revolute ? q[j] * kDeg : q[j];
+    const double lo = revolute ? joint.lower * kDeg : joint.lower;
+    const double hi = revolute ? joint.upper * kDeg : joint.upper;
+    const std::string label = joint.name + (revolute ? " [deg]" : " [m]");
+    if (ImGui::SliderScalar(label.c_str(), ImGuiDataType_Double, &v, &lo, &hi,
+                            revolute ? "%.1f" : "%.3f", ImGuiSliderFlags_AlwaysClamp)) {
+      q[j] = revolute ? v / kDeg : v;
+      changed = true;
+    }
+    if (ImGui::IsItemHovered()) {
+      ImGui::SetTooltip(
+          "Joint %zu of '%s', limits %.1f to %.1f%s: the viewport shows the arm here "
+          "(not saved; the planner starts every robot at home)",
+          j + 1, name.c_str(), lo, hi, revolute ? " deg" : " m");
+    }
+  }
+  if (changed) app.jog[name] = q;
+  const Iso3 X_WT = TcpPose(robot.chain, robot.X_WB, q, robot.end_effector.X_FT);
+  const Vec3 rpy = RpyFromRotation(X_WT.linear()) * kDeg;
+  ImGui::TextDisabled("TCP xyz %.3f %.3f %.3f m, rpy %.1f %.1f %.1f deg", X_WT.translation().x(),
+                      X_WT.translation().y(), X_WT.translation().z(), rpy.x(), rpy.y(), rpy.z());
+  if (ImGui::SmallButton("Home")) app.jog.erase(name);
+  ImGui::TreePop();
 }
 
 void RobotsPanel::AddUrdf(AppState& app, const std::string& path) {
@@ -383,6 +461,7 @@ void RobotsPanel::Draw(AppState& app, const PanelRect& r) {
                                                     : "base pose (mount frame)");
     changed |= EditPose("base", robot.base_pose);
     if (changed) app.Do(SetRobot(robot.name, robot, "robot:" + robot.name));
+    JointSliders(app, robot.name);
 
     // Wrench limits: the robot's own table, or the project's (shared by every robot).
     bool own = robot.wrench_limits.has_value();
@@ -394,16 +473,17 @@ void RobotsPanel::Draw(AppState& app, const PanelRect& r) {
     ImGui::TextDisabled(own ? "limits of this robot (grasp frame)"
                             : "project's limits, all robots (grasp frame; paper's values)");
     bool l = false;
+    const std::string lkey = "limits." + (own ? robot.name : std::string("project")) + ".";
     if (ImGui::TreeNodeEx("two-finger", ImGuiTreeNodeFlags_DefaultOpen)) {
-      l |= EditBox("tf", limits.two_finger);
+      l |= EditBox(app, "tf", lkey + "two_finger", limits.two_finger, false);
       ImGui::TreePop();
     }
     if (ImGui::TreeNode("vacuum, assembly")) {
-      l |= EditBox("va", limits.vacuum_assembly);
+      l |= EditBox(app, "va", lkey + "vacuum_assembly", limits.vacuum_assembly, false);
       ImGui::TreePop();
     }
     if (ImGui::TreeNode("vacuum, transport")) {
-      l |= EditBox("vt", limits.vacuum_transport);
+      l |= EditBox(app, "vt", lkey + "vacuum_transport", limits.vacuum_transport, false);
       ImGui::TreePop();
     }
     if (l) app.Do(SetWrenchLimits(own ? robot.name : "", limits, "limits:" + robot.name));

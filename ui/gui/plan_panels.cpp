@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "gui/panels.h"
 
@@ -24,18 +25,6 @@ Rgba UtilisationColour(double u) {
   const double r = x < 0.7 ? x / 0.7 : 1.0;
   const double g = x < 0.7 ? 1.0 : std::max(0.0, 1.0 - (x - 0.7) / 0.3);
   return {(60 + 195 * r) / 255.0, (60 + 160 * g) / 255.0, 60 / 255.0, 1.0};
-}
-
-void FrameStats::Add(double seconds) {
-  seconds_.push_back(seconds);
-  while (seconds_.size() > kKept) seconds_.pop_front();
-}
-
-double FrameStats::MedianFps() const {
-  if (seconds_.empty()) return 0.0;
-  std::vector<double> s(seconds_.begin(), seconds_.end());
-  std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
-  return s[s.size() / 2] > 0.0 ? 1.0 / s[s.size() / 2] : 0.0;
 }
 
 std::vector<double> AppState::KeyframeTimes() const {
@@ -115,10 +104,7 @@ void PlannerPanel::Draw(AppState& app, const PanelRect& r) {
   ImGui::EndDisabled();
 
   if (!running) {
-    if (ImGui::Button("Run", ImVec2(90, 0))) {
-      app.job.Start(app.doc.project(), app.doc.ResolvePath(), q);
-      app.Notify("Planning started on a snapshot of the project");
-    }
+    if (ImGui::Button("Run", ImVec2(90, 0))) StartRun(app);
   } else if (ImGui::Button("Cancel", ImVec2(90, 0))) {
     app.job.Cancel();
   }
@@ -126,14 +112,30 @@ void PlannerPanel::Draw(AppState& app, const PanelRect& r) {
   ImGui::SameLine();
   ImGui::Text("%s  %.1f s", ToString(prog.state), prog.elapsed_s);
   if (prog.state == JobState::kRunning) {
+    // Every stage the run went through, with its time, then the current one's progress: the
+    // stage's name and its count ("motion: action 5/12: free path 3 for 'ur5e_a'").
+    std::string trail;
+    for (size_t i = 0; i < prog.stages.size(); ++i) {
+      const JobStage& st = prog.stages[i];
+      const double end = i + 1 < prog.stages.size() ? prog.stages[i + 1].start_s : prog.elapsed_s;
+      char t[32];
+      std::snprintf(t, sizeof t, " %.1f s", end - st.start_s);
+      trail += (i ? " > " : "") + st.name + t;
+    }
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+    ImGui::TextWrapped("%s", trail.c_str());
+    ImGui::PopStyleColor();
     const float f = prog.fraction >= 0 ? static_cast<float>(prog.fraction)
                                        : static_cast<float>(std::fmod(prog.elapsed_s, 1.0));
     ImGui::ProgressBar(f, ImVec2(-1, 0), (prog.stage + ": " + prog.message).c_str());
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("%s: %s", prog.stage.c_str(), prog.message.c_str());
   }
   if (!prog.error.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
     ImGui::TextWrapped("%s", prog.error.c_str());
     ImGui::PopStyleColor();
+    if (app.run_failure && ImGui::SmallButton("Show in Problems")) app.focus_problems = true;
   }
   ImGui::BeginChild("log", ImVec2(0, 0), true);
   for (const std::string& line : prog.log) ImGui::TextWrapped("%s", line.c_str());
@@ -142,21 +144,41 @@ void PlannerPanel::Draw(AppState& app, const PanelRect& r) {
   ImGui::End();
 }
 
-void PlanPanel::Draw(AppState& app, const PanelRect& r) {
-  PlaceNextWindow(r);
-  if (!ImGui::Begin("Plan", nullptr, ImGuiWindowFlags_NoCollapse)) {
-    ImGui::End();
-    return;
+void StartRun(AppState& app) {
+  if (app.job.Start(app.doc.project(), app.doc.ResolvePath(), app.request)) {
+    app.showing_case = -1;
+    app.Notify("Planning started on a snapshot of the project");
   }
+}
+
+void PlanPanel::Contents(AppState& app) {
   if (!app.plan) {
     ImGui::TextDisabled("No plan yet: run the planner (Planner panel) or open a plan file.");
-    ImGui::End();
     return;
   }
   const Plan& plan = *app.plan;
   const bool motion = plan.stats.motion && !plan.trajectories.empty();
   const double duration = app.Duration();
   Playback& pb = app.playback;
+  // A plan of another state of the project: greyed, not played, with a way to plan again.
+  const bool stale = app.PlanStale();
+  if (stale) {
+    pb.playing = false;
+    ImGui::PushStyleColor(ImGuiCol_ChildBg, ImVec4(0.35f, 0.25f, 0.08f, 1.0f));
+    ImGui::BeginChild("stale", ImVec2(0, ImGui::GetFrameHeightWithSpacing() + 6), true,
+                      ImGuiWindowFlags_NoScrollbar);
+    ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.35f, 1.0f),
+                       "Out of date: the project changed since this plan was made.");
+    ImGui::SameLine();
+    ImGui::BeginDisabled(app.job.running());
+    if (ImGui::SmallButton("Re-plan")) StartRun(app);
+    ImGui::EndDisabled();
+    ImGui::SameLine();
+    ImGui::TextDisabled("(undo back to it to show it again)");
+    ImGui::EndChild();
+    ImGui::PopStyleColor();
+  }
+  ImGui::BeginDisabled(stale);
   if (ImGui::Button(pb.playing ? "Pause" : "Play", ImVec2(60, 0))) pb.playing = !pb.playing;
   ImGui::SameLine();
   if (ImGui::Button("|<")) pb.t = 0;
@@ -203,13 +225,14 @@ void PlanPanel::Draw(AppState& app, const PanelRect& r) {
       if (std::find(a.robots.begin(), a.robots.end(), rb) == a.robots.end()) continue;
       const double end = keyframe_time[i];
       const double start = motion ? std::max(0.0, a.start_s) : end - (a.approach ? 2 : 1);
-      const ImU32 col = a.type == ActionType::kAssemble ? IM_COL32(230, 140, 50, 255)
-                        : a.type == ActionType::kPick   ? IM_COL32(80, 150, 220, 255)
-                                                        : IM_COL32(120, 180, 120, 255);
+      const ImU32 col = stale                             ? IM_COL32(90, 92, 96, 255)
+                        : a.type == ActionType::kAssemble ? IM_COL32(230, 140, 50, 255)
+                        : a.type == ActionType::kPick     ? IM_COL32(80, 150, 220, 255)
+                                                          : IM_COL32(120, 180, 120, 255);
       dl->AddRectFilled(ImVec2(x_of(start), y + 1),
                         ImVec2(std::max(x_of(end), x_of(start) + 2), y + lane_h - 1), col, 2.0f);
       // The gripper's wrench utilisation at this action as a band along the bar's foot.
-      if (const auto u = a.utilisation.find(rb); u != a.utilisation.end()) {
+      if (const auto u = a.utilisation.find(rb); u != a.utilisation.end() && !stale) {
         dl->AddRectFilled(ImVec2(x_of(start), y + lane_h - 4),
                           ImVec2(std::max(x_of(end), x_of(start) + 2), y + lane_h - 1),
                           UtilisationImColour(u->second));
@@ -220,7 +243,7 @@ void PlanPanel::Draw(AppState& app, const PanelRect& r) {
   dl->AddLine(ImVec2(x_of(pb.t), origin.y), ImVec2(x_of(pb.t), origin.y + lanes_h),
               IM_COL32(255, 255, 255, 255), 2.0f);
   ImGui::InvisibleButton("lanes", ImVec2(label_w + width, std::max(lanes_h, 1.0f)));
-  if (ImGui::IsItemActive()) {
+  if (ImGui::IsItemActive() && !stale) {
     const double f = (ImGui::GetIO().MousePos.x - origin.x - label_w) / width;
     pb.t = std::clamp(f, 0.0, 1.0) * duration;
     pb.playing = false;
@@ -260,7 +283,7 @@ void PlanPanel::Draw(AppState& app, const PanelRect& r) {
     }
   }
   ImGui::EndChild();
-  ImGui::End();
+  ImGui::EndDisabled();
 }
 
 }  // namespace wrap::gui

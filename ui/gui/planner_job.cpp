@@ -42,19 +42,33 @@ bool PlannerJob::Start(Project project, std::filesystem::path project_file,
                        PlannerRequest request) {
   if (running()) return false;
   if (worker_.joinable()) worker_.join();
+  auto snapshot = std::make_shared<const Project>(std::move(project));
   {
     std::lock_guard lock(mutex_);
     progress_ = JobProgress{};
     progress_.state = JobState::kRunning;
     progress_.stage = "validate";
+    progress_.stages.push_back({"validate", 0.0});
     plan_.reset();
+    snapshot_ = snapshot;
+    ++run_id_;
     started_ = std::chrono::steady_clock::now();
   }
-  worker_ = std::jthread([this, p = std::move(project), f = std::move(project_file),
+  worker_ = std::jthread([this, p = *snapshot, f = std::move(project_file),
                           r = std::move(request)](std::stop_token stop) mutable {
     Run(stop, std::move(p), std::move(f), std::move(r));
   });
   return true;
+}
+
+std::shared_ptr<const Project> PlannerJob::snapshot() const {
+  std::lock_guard lock(mutex_);
+  return snapshot_;
+}
+
+unsigned long PlannerJob::run_id() const {
+  std::lock_guard lock(mutex_);
+  return run_id_;
 }
 
 void PlannerJob::Cancel() {
@@ -115,10 +129,21 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
     ctx.set_time_limit_s(request.time_limit_s);
     ctx.set_progress([this](const std::string& stage, double fraction, const std::string& msg) {
       std::lock_guard lock(mutex_);
+      if (progress_.stages.empty() || progress_.stages.back().name != stage) {
+        progress_.stages.push_back(
+            {stage,
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count()});
+      }
       progress_.stage = stage;
       progress_.fraction = fraction;
       progress_.message = msg;
       progress_.log.push_back(stage + ": " + msg);
+      // The log is copied to the GUI every frame: keep its last kMaxLog lines.
+      constexpr size_t kMaxLog = 1000;
+      if (progress_.log.size() > 2 * kMaxLog) {
+        progress_.log.erase(progress_.log.begin(),
+                            progress_.log.end() - static_cast<long>(kMaxLog));
+      }
     });
     auto stage = [&](const char* name, const std::string& message) {
       ctx.Progress(name, -1.0, message);
@@ -130,8 +155,7 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
     };
 
     stage("validate", "checking '" + project.name + "' (meshes, DAG, robots)");
-    ProjectCheck check = ValidateProject(project, file);
-    check.diagnostics.Append(CheckRobots(project, file));
+    ProjectCheck check = CheckProject(project, file);
     if (check.diagnostics.has_errors()) {
       std::string message = "the project is not valid:";
       int shown = 0;
@@ -163,7 +187,11 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
       Finish(JobState::kFailed, "preprocessing: " + pre.error().message, nullptr);
       return;
     }
-    for (const std::string& w : pre->warnings) Log("warning: " + w);
+    for (const std::string& w : pre->warnings) {
+      Log("warning: " + w);
+      std::lock_guard lock(mutex_);
+      progress_.warnings.push_back(w);
+    }
 
     stage("task", "searching for a task plan (" + request.planner + ")");
     PipelineOptions pipeline;
@@ -179,14 +207,20 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
       return;
     }
     plan->stats.seed = request.seed;
-    const PlanStats& st = plan->stats;
-    Log("cost " + std::to_string(st.cost) + ", " + std::to_string(plan->actions.size()) +
-        " actions" + (st.motion ? ", makespan " + std::to_string(st.makespan_s) + " s" : ""));
+    // The plan moves into the shared one: its stats are read from there (reading them through
+    // the moved-from plan gave an empty failure, "no plan found", where the CLI said why).
     auto shared = std::make_shared<const Plan>(std::move(*plan));
+    const PlanStats& st = shared->stats;
+    Log("cost " + std::to_string(st.cost) + ", " + std::to_string(shared->actions.size()) +
+        " actions" + (st.motion ? ", makespan " + std::to_string(st.makespan_s) + " s" : ""));
     if (st.solved) {
       Finish(JobState::kSolved, "", shared);
     } else {
       // A task plan without motion still has keyframes worth showing.
+      if (st.failure_detail) {
+        std::lock_guard lock(mutex_);
+        progress_.failure = std::make_shared<const PlanFailure>(*st.failure_detail);
+      }
       Finish(JobState::kNoPlan, st.failure.empty() ? "no plan found" : st.failure,
              shared->actions.empty() ? nullptr : shared);
     }

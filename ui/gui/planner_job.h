@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "model/project.h"
+#include "task/failure.h"
 #include "task/plan.h"
 
 namespace wrap::gui {
@@ -37,6 +38,12 @@ enum class JobState { kIdle, kRunning, kSolved, kNoPlan, kFailed, kCancelled };
 /// "idle", "running", "solved", "no plan", "failed", "cancelled".
 const char* ToString(JobState state);
 
+/// A stage the run has entered, for the progress line ("validate 0.1 s > preprocess 2.3 s > ...").
+struct JobStage {
+  std::string name;      ///< "validate", "preprocess", "task", "keyframes", "motion", "retime", ...
+  double start_s = 0.0;  ///< When the run entered it, since the start [s].
+};
+
 /// What the GUI reads each frame (a copy, taken under the job's lock).
 struct JobProgress {
   JobState state = JobState::kIdle;  ///< Where the run is.
@@ -44,7 +51,12 @@ struct JobProgress {
   double fraction = -1.0;            ///< Of the stage, in [0, 1]; negative: unknown.
   std::string message;               ///< Latest progress message.
   std::vector<std::string> log;      ///< Every message so far, oldest first.
+  std::vector<JobStage> stages;      ///< The stages entered so far, in order.
   std::string error;                 ///< Why the run failed or found no plan (in words).
+  std::vector<std::string> warnings;  ///< Preprocessing's warnings (as `wrap plan` prints them).
+  /// The failure as data when the planner found no plan (the CLI's words in `text`, the checks
+  /// that failed with the cell at each); null when it solved, or failed before planning.
+  std::shared_ptr<const PlanFailure> failure;
   double elapsed_s = 0.0;            ///< Since the start [s].
 };
 
@@ -59,6 +71,11 @@ class PlannerJob {
   /// Starts planning `project` (a snapshot; relative paths resolve against `project_file`).
   /// Returns false (and does nothing) while a run is under way.
   bool Start(Project project, std::filesystem::path project_file, PlannerRequest request);
+  /// The project of the last run started (its snapshot; null before any run): a plan is
+  /// current while the document still equals it.
+  std::shared_ptr<const Project> snapshot() const;
+  /// Counts the runs started (0: none yet): the GUI takes each run's outcome once.
+  unsigned long run_id() const;
   /// Asks the run to stop: it ends with kCancelled within a fraction of a second.
   void Cancel();
   /// True while the worker runs.
@@ -79,6 +96,8 @@ class PlannerJob {
 
   mutable std::mutex mutex_;
   JobProgress progress_;
+  std::shared_ptr<const Project> snapshot_;
+  unsigned long run_id_ = 0;
   std::shared_ptr<const Plan> plan_;
   std::chrono::steady_clock::time_point started_;
   std::jthread worker_;

@@ -1,11 +1,14 @@
 #include "gui/script.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
 #include <sstream>
 
 #include "gui/commands.h"
+#include "gui/fields.h"
+#include "gui/panels.h"
 
 namespace wrap::gui {
 
@@ -15,16 +18,47 @@ namespace {
 
 // Command name -> (least, most) arguments.
 const std::map<std::string, std::pair<int, int>>& Arity() {
-  static const std::map<std::string, std::pair<int, int>> arity = {
-      {"select", {2, 2}},        {"import", {1, 2}},    {"add-step", {1, 1}},
-      {"delete-step", {1, 1}},   {"rename", {2, 2}},    {"add-edge", {2, 2}},
-      {"remove-edge", {2, 2}},   {"add-robot", {2, 2}}, {"remove-robot", {1, 1}},
-      {"set", {2, 5}},           {"undo", {0, 0}},      {"redo", {0, 0}},
-      {"option", {2, 2}},        {"run", {0, 0}},       {"wait", {0, 0}},
-      {"expect-plan", {0, 0}},   {"scrub", {1, 1}},     {"play", {0, 0}},
-      {"pause", {0, 0}},         {"save", {0, 1}},      {"screenshot", {1, 1}},
-      {"expect-refused", {1, 6}}, {"autosave", {0, 0}},  {"sleep", {1, 1}},
-      {"add-urdf", {2, 4}},      {"view", {2, 2}}};
+  static const std::map<std::string, std::pair<int, int>> arity = {{"select", {2, 2}},
+                                                                   {"import", {1, 2}},
+                                                                   {"add-step", {1, 1}},
+                                                                   {"delete-step", {1, 1}},
+                                                                   {"rename", {2, 2}},
+                                                                   {"add-edge", {2, 2}},
+                                                                   {"remove-edge", {2, 2}},
+                                                                   {"add-robot", {2, 2}},
+                                                                   {"remove-robot", {1, 1}},
+                                                                   {"set", {2, 5}},
+                                                                   {"undo", {0, 0}},
+                                                                   {"redo", {0, 0}},
+                                                                   {"option", {2, 2}},
+                                                                   {"run", {0, 0}},
+                                                                   {"wait", {0, 0}},
+                                                                   {"expect-plan", {0, 0}},
+                                                                   {"scrub", {1, 1}},
+                                                                   {"play", {0, 0}},
+                                                                   {"pause", {0, 0}},
+                                                                   {"save", {0, 1}},
+                                                                   {"screenshot", {1, 1}},
+                                                                   {"expect-refused", {1, 6}},
+                                                                   {"autosave", {0, 0}},
+                                                                   {"sleep", {1, 1}},
+                                                                   {"add-urdf", {2, 4}},
+                                                                   {"view", {2, 2}},
+                                                                   {"new", {0, 0}},
+                                                                   {"open", {1, 1}},
+                                                                   {"validate", {0, 0}},
+                                                                   {"show", {1, 1}},
+                                                                   {"jog", {3, 3}},
+                                                                   {"measure", {2, 2}},
+                                                                   {"expect-problem", {1, 64}},
+                                                                   {"expect-no-problem", {1, 64}},
+                                                                   {"expect-marked", {1, 1}},
+                                                                   {"expect-selected", {2, 2}},
+                                                                   {"expect-plan-stale", {0, 0}},
+                                                                   {"expect-plan-current", {0, 0}},
+                                                                   {"expect-field-error", {1, 64}},
+                                                                   {"expect-undo", {1, 64}},
+                                                                   {"expect-viewport", {1, 1}}};
   return arity;
 }
 
@@ -72,6 +106,16 @@ Result<void> SetField(AppState& app, const ScriptLine& line) {
     app.doc.CloseMerge();
     return {};
   };
+  // The editors' ranges (fields.h): a value outside them is refused at the field, as typed.
+  auto ranged = [&](std::string_view spec_kind, double v) -> Result<void> {
+    const FieldSpec* spec = FindField(spec_kind, field);
+    if (!spec) return {};
+    const std::string key = name.empty() ? kind + "." + field : kind + "." + name + "." + field;
+    const std::string why = RefusedValue(*spec, v);
+    SetFieldError(app, key, why);
+    if (!why.empty()) return LineError(line, why);
+    return {};
+  };
 
   if (kind == "part") {
     auto it =
@@ -81,6 +125,7 @@ Result<void> SetField(AppState& app, const ScriptLine& line) {
     if (field == "mass_kg" || field == "density_kg_m3" || field == "scale") {
       auto v = scalar();
       if (!v) return std::unexpected(v.error());
+      if (auto ok = ranged("part", *v); !ok) return ok;
       if (field == "mass_kg") part.mass_kg = *v;
       if (field == "density_kg_m3") part.density_kg_m3 = *v;
       if (field == "scale") part.scale = *v;
@@ -112,6 +157,7 @@ Result<void> SetField(AppState& app, const ScriptLine& line) {
     } else {
       auto v = scalar();
       if (!v) return std::unexpected(v.error());
+      if (auto ok = ranged("mating", *v); !ok) return ok;
       if (field == "force_N")
         m.force_N = *v;
       else if (field == "torque_Nm")
@@ -150,6 +196,7 @@ Result<void> SetField(AppState& app, const ScriptLine& line) {
     Table t = p.table;
     auto v = scalar();
     if (!v) return std::unexpected(v.error());
+    if (auto ok = ranged("table", *v); !ok) return ok;
     if (field == "height")
       t.height = *v;
     else if (field == "friction")
@@ -173,6 +220,112 @@ Result<void> SetField(AppState& app, const ScriptLine& line) {
     return run(SetPlannerDefaults(d));
   }
   return unknown();
+}
+
+/// Words from `first` on, joined by single spaces.
+std::string Rest(const ScriptLine& line, size_t first) {
+  std::string out;
+  for (size_t i = first; i < line.words.size(); ++i) out += (i > first ? " " : "") + line.words[i];
+  return out;
+}
+
+/// Every line the Problems panel shows: the run's failure (its headline and each failed check)
+/// and the validation's diagnostics ("step 's1' / mating.force_N: MESSAGE").
+std::vector<std::string> ProblemLines(const AppState& app) {
+  std::vector<std::string> lines;
+  if (app.run_failure) {
+    lines.push_back(app.run_failure->headline);
+    if (app.run_failure->failure) {
+      for (const FailureCase& c : app.run_failure->failure->cases) lines.push_back(c.text);
+    }
+  }
+  for (const std::string& w : app.run_warnings) lines.push_back("warning " + w);
+  const ValidationResult v = app.validation.result();
+  const Project& checked = v.project ? *v.project : app.doc.project();
+  for (const Diagnostic& d : v.diagnostics.items) {
+    const EntityRef e = EntityOfPath(checked, d.path);
+    lines.push_back(std::string(d.severity == Severity::kError ? "error " : "warning ") +
+                    e.Label() + (e.field.empty() ? "" : " / " + e.field) + ": " + d.message);
+  }
+  return lines;
+}
+
+/// The checks of what a frame drew or the state it left (`expect-*`), or null for another command.
+Result<std::function<Result<void>(const AppState&)>> ExpectCheck(const ScriptLine& line) {
+  const std::vector<std::string>& w = line.words;
+  const std::string& cmd = w[0];
+  using Check = std::function<Result<void>(const AppState&)>;
+  auto fail = [line](const std::string& message) { return LineError(line, message); };
+  if (cmd == "expect-problem" || cmd == "expect-no-problem") {
+    const std::string text = Rest(line, 1);
+    const bool want = cmd == "expect-problem";
+    return Check([text, want, fail](const AppState& app) -> Result<void> {
+      const std::vector<std::string> lines = ProblemLines(app);
+      const bool found = std::any_of(lines.begin(), lines.end(), [&](const std::string& l) {
+        return l.find(text) != std::string::npos;
+      });
+      if (found == want) return {};
+      std::string shown;
+      for (const std::string& l : lines) shown += "\n  " + l;
+      return fail(
+          std::string(want ? "the Problems panel does not show '" : "the Problems panel shows '") +
+          text + "'; it shows:" + (shown.empty() ? " nothing" : shown));
+    });
+  }
+  if (cmd == "expect-marked") {
+    const std::string step = w[1] == "none" ? "" : w[1];
+    return Check([step, fail](const AppState& app) -> Result<void> {
+      if (app.canvas_marked == step) return {};
+      return fail("the canvas marks '" + app.canvas_marked + "', not '" + step + "'");
+    });
+  }
+  if (cmd == "expect-selected") {
+    const std::string kind = w[1], name = w[2];
+    return Check([kind, name, fail](const AppState& app) -> Result<void> {
+      const std::string& got = kind == "part"   ? app.selection.part
+                               : kind == "step" ? app.selection.step
+                                                : app.selection.robot;
+      if (got == name) return {};
+      return fail("selected " + kind + " is '" + got + "', not '" + name + "'");
+    });
+  }
+  if (cmd == "expect-plan-stale" || cmd == "expect-plan-current") {
+    const bool stale = cmd == "expect-plan-stale";
+    return Check([stale, fail](const AppState& app) -> Result<void> {
+      if (!app.plan) return fail("no plan on show");
+      if (app.PlanStale() == stale) return {};
+      return fail(stale ? "the plan is shown as current" : "the plan is shown as out of date");
+    });
+  }
+  if (cmd == "expect-field-error") {
+    const std::string key = w[1], text = Rest(line, 2);
+    return Check([key, text, fail](const AppState& app) -> Result<void> {
+      auto it = app.field_errors.find(key);
+      if (it == app.field_errors.end()) return fail("no refusal shown at field '" + key + "'");
+      if (it->second.find(text) == std::string::npos) {
+        return fail("field '" + key + "' shows '" + it->second + "', not '" + text + "'");
+      }
+      return {};
+    });
+  }
+  if (cmd == "expect-undo") {
+    const std::string text = Rest(line, 1);
+    return Check([text, fail](const AppState& app) -> Result<void> {
+      if (app.doc.CanUndo() && app.doc.UndoLabel().find(text) != std::string::npos) return {};
+      return fail("Edit > Undo reads '" + app.doc.UndoLabel() + "', not '" + text + "'");
+    });
+  }
+  if (cmd == "expect-viewport") {
+    const bool cell = w[1] == "cell";
+    if (!cell && w[1] != "empty") return LineError(line, "expect-viewport cell|empty");
+    return Check([cell, fail](const AppState& app) -> Result<void> {
+      const bool drawn = app.viewport.ready() && (!app.viewport.scene().parts.empty() ||
+                                                  !app.viewport.scene().robots.empty());
+      if (drawn == cell) return {};
+      return fail(cell ? "the viewport draws no cell" : "the viewport still draws a cell");
+    });
+  }
+  return Check{};
 }
 
 }  // namespace
@@ -301,9 +454,8 @@ Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const 
     return effect;
   }
   if (cmd == "run") {
-    if (!app.job.Start(app.doc.project(), app.doc.ResolvePath(), app.request)) {
-      return LineError(line, "the planner is already running");
-    }
+    if (app.job.running()) return LineError(line, "the planner is already running");
+    StartRun(app);
     return effect;
   }
   if (cmd == "wait") {
@@ -347,6 +499,72 @@ Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const 
   }
   if (cmd == "screenshot") {
     effect.screenshot = resolve(w[1]);
+    return effect;
+  }
+  if (cmd.starts_with("expect-") && cmd != "expect-refused" && cmd != "expect-plan") {
+    auto check = ExpectCheck(line);
+    if (!check) return std::unexpected(check.error());
+    effect.check = std::move(*check);
+    return effect;
+  }
+  if (cmd == "new") {
+    effect.new_document = true;
+    return effect;
+  }
+  if (cmd == "open") {
+    effect.open = resolve(w[1]);
+    return effect;
+  }
+  if (cmd == "validate") {
+    effect.wait_for_validation = true;
+    return effect;
+  }
+  if (cmd == "show") {
+    if (w[1] == "off") {
+      ShowFailureCase(app, -1);
+      return effect;
+    }
+    auto n = Number(line, w[1]);
+    if (!n) return std::unexpected(n.error());
+    const int count = app.run_failure && app.run_failure->failure
+                          ? static_cast<int>(app.run_failure->failure->cases.size())
+                          : 0;
+    if (*n < 1 || *n > count) {
+      return LineError(
+          line, "show N: the last run has " + std::to_string(count) + " failed check(s) to show");
+    }
+    ShowFailureCase(app, static_cast<int>(*n) - 1);
+    return effect;
+  }
+  if (cmd == "jog") {
+    auto joint = Number(line, w[2]);
+    auto deg = Number(line, w[3]);
+    if (!joint || !deg) return LineError(line, "jog ROBOT JOINT DEG: numbers expected");
+    if (!app.viewport.ready()) return LineError(line, "jog: no cell drawn");
+    for (const SceneRobot& r : app.viewport.scene().robots) {
+      if (r.name != w[1]) continue;
+      const int j = static_cast<int>(*joint) - 1;
+      if (j < 0 || j >= static_cast<int>(r.home.size())) {
+        return LineError(line,
+                         "robot '" + w[1] + "' has joints 1 to " + std::to_string(r.home.size()));
+      }
+      JointVector q = app.jog.count(w[1]) ? app.jog[w[1]] : r.home;
+      q[j] = *deg * std::numbers::pi / 180.0;
+      app.jog[w[1]] = q;
+      return effect;
+    }
+    return LineError(line, "there is no robot '" + w[1] + "'");
+  }
+  if (cmd == "measure") {
+    if (w[1] != "idle" && w[1] != "orbit" && w[1] != "play") {
+      return LineError(line, "measure idle|orbit|play SECONDS");
+    }
+    auto seconds = Number(line, w[2]);
+    if (!seconds || *seconds <= 0 || *seconds > 600) {
+      return LineError(line, "measure wants 0 to 600 seconds");
+    }
+    effect.measure = w[1];
+    effect.measure_s = *seconds;
     return effect;
   }
   if (cmd == "expect-refused") {

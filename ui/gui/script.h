@@ -28,9 +28,26 @@
 //   sleep SECONDS                      keep drawing frames for that long
 //   view utilisation on|off            grippers tinted by wrench utilisation during playback
 //   view quality auto|fine|fast        the viewport's drawing quality (View menu)
+//   new | open FILE                    File > New, File > Open (unsaved edits discarded)
+//   validate                           wait for the live validation of the document as it is
+//   show N | show off                  the Problems panel's "Show" of failed check N (1: the
+//                                      blocker), or back to the cell
+//   jog ROBOT JOINT DEG                a robot's joint slider (joint from 1)
+//   measure idle|orbit|play SECONDS    draw frames for that long (orbiting the camera, or
+//                                      playing the plan) and print the frame rate
+//   expect-problem TEXT...             fail unless the Problems panel shows TEXT (the run's
+//                                      failure or a validation diagnostic)
+//   expect-no-problem TEXT...          the opposite
+//   expect-marked STEP|none            the DAG canvas marks STEP as where the last run failed
+//   expect-selected part|step|robot NAME
+//   expect-plan-stale | expect-plan-current
+//   expect-field-error FIELD [TEXT...] a refusal is shown at FIELD (e.g. mating.s1.force_N)
+//   expect-undo TEXT...                the Edit menu's undo label holds TEXT
+//   expect-viewport cell|empty         the viewport has a cell drawn, or none
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -55,6 +72,13 @@ struct ScriptEffect {
   std::filesystem::path screenshot;  ///< Save the window to this file at the next frame.
   bool autosave = false;             ///< Turn the recovery autosave on.
   double sleep_s = 0.0;              ///< Keep drawing frames this long before the next line.
+  bool new_document = false;         ///< File > New.
+  std::filesystem::path open;        ///< File > Open this project.
+  bool wait_for_validation = false;  ///< Hold the script until the live validation is current.
+  std::string measure;               ///< Measure the frame rate: "idle", "orbit" or "play".
+  double measure_s = 0.0;            ///< ... for this long [s].
+  /// A check of what the next frame drew (run after it); fails the line with its message.
+  std::function<Result<void>(const AppState&)> check;
 };
 
 /// Runs one line against `app`; relative paths resolve against `base_dir`. A refused edit fails

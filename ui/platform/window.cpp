@@ -14,6 +14,7 @@
 #include <cstring>
 #include <mutex>
 #include <utility>
+#include <vector>
 
 namespace wrap::platform {
 
@@ -51,6 +52,37 @@ std::vector<std::string>* dropped_sink = nullptr;
 
 void OnGlfwError(int code, const char* description) {
   glfw_error = "GLFW error " + std::to_string(code) + ": " + (description ? description : "");
+}
+
+// Keys pressed and released between two frames (a quick tap while a software-GL frame takes
+// 100-250 ms, or xdotool's key) would never be seen down by Dear ImGui 1.86, which keeps only the
+// state of each key: Ctrl+Z was lost. A release that would reach ImGui in the same frame as its
+// press is passed on at the start of the frame after.
+struct KeyEvent {
+  GLFWwindow* window;
+  int key, scancode, action, mods;
+  int deliver_at;  // frame number
+};
+int frame_number = 0;  // counts BeginFrame calls
+bool polling = false;  // inside BeginFrame's poll (events reach this frame, else the next)
+std::vector<std::pair<int, int>> key_seen;  // key -> frame its last press reaches ImGui
+std::vector<KeyEvent> deferred_releases;
+
+void OnKey(GLFWwindow* window, int key, int scancode, int action, int mods) {
+  const int seen = polling ? frame_number : frame_number + 1;
+  auto pressed = std::find_if(key_seen.begin(), key_seen.end(),
+                              [&](const std::pair<int, int>& k) { return k.first == key; });
+  if (action == GLFW_PRESS) {
+    if (pressed == key_seen.end()) {
+      key_seen.push_back({key, seen});
+    } else {
+      pressed->second = seen;
+    }
+  } else if (action == GLFW_RELEASE && pressed != key_seen.end() && pressed->second >= seen) {
+    deferred_releases.push_back({window, key, scancode, action, mods, pressed->second + 1});
+    return;
+  }
+  ImGui_ImplGlfw_KeyCallback(window, key, scancode, action, mods);
 }
 
 void OnDrop(GLFWwindow*, int count, const char** paths) {
@@ -125,6 +157,7 @@ Result<std::unique_ptr<Window>> Window::Create(const WindowOptions& options) {
   style.WindowRounding = 0.0f;
   style.FrameRounding = 2.0f;
   w->glfw_backend_ = ImGui_ImplGlfw_InitForOpenGL(w->window_, true);
+  glfwSetKeyCallback(w->window_, OnKey);  // forwards to the backend's, see OnKey
   w->gl3_backend_ = w->glfw_backend_ && ImGui_ImplOpenGL3_Init("#version 130");
   if (!w->gl3_backend_) {
     return Fail(ErrorCode::kInvalidInput, "Dear ImGui's OpenGL 3 backend did not start");
@@ -142,7 +175,19 @@ Window::~Window() {
 }
 
 void Window::BeginFrame() {
+  ++frame_number;
+  std::vector<KeyEvent> later;
+  for (const KeyEvent& e : std::exchange(deferred_releases, {})) {
+    if (e.deliver_at > frame_number) {
+      later.push_back(e);
+    } else {
+      ImGui_ImplGlfw_KeyCallback(e.window, e.key, e.scancode, e.action, e.mods);
+    }
+  }
+  deferred_releases = std::move(later);
+  polling = true;
   glfwPollEvents();
+  polling = false;
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();

@@ -22,6 +22,8 @@ struct ViewportRenderer::Impl {
   std::unique_ptr<mjData, void (*)(mjData*)> data{nullptr, mj_deleteData};
   std::vector<int> part_body;  // body id per part
   std::vector<int> body_robot;  // per body: the robot whose end effector it belongs to, or -1
+  std::vector<int> body_arm;    // per body: the robot it belongs to (links, gripper), or -1
+  int table_body = -1;          // the table's body
   mjvScene mjscene;
   mjvOption option;
   mjvCamera camera;
@@ -84,6 +86,21 @@ Result<void> ViewportRenderer::Build(const Project& project, const std::filesyst
   for (const std::string& body : doc->part_bodies) {
     next->part_body.push_back(mj_name2id(m, mjOBJ_BODY, body.c_str()));
   }
+  // Every body of robot r: named "robot:NAME/..." or below its link0.
+  next->body_arm.assign(m->nbody, -1);
+  for (size_t r = 0; r < next->scene.robots.size(); ++r) {
+    const std::string prefix = "robot:" + next->scene.robots[r].name + "/";
+    for (int b = 1; b < m->nbody; ++b) {
+      const char* name = mj_id2name(m, mjOBJ_BODY, b);
+      if (name && std::string(name).starts_with(prefix)) next->body_arm[b] = static_cast<int>(r);
+    }
+  }
+  for (int b = 1; b < m->nbody; ++b) {
+    if (next->body_arm[b] < 0 && next->body_arm[m->body_parentid[b]] >= 0) {
+      next->body_arm[b] = next->body_arm[m->body_parentid[b]];
+    }
+  }
+  next->table_body = mj_name2id(m, mjOBJ_BODY, "table");
   // The end effector of robot r: the body "robot:NAME/ee" and everything below it (fingers).
   next->body_robot.assign(m->nbody, -1);
   for (size_t r = 0; r < next->scene.robots.size(); ++r) {
@@ -129,6 +146,8 @@ Result<void> ViewportRenderer::Build(const Project& project, const std::filesyst
   return {};
 }
 
+void ViewportRenderer::Clear() { impl_.reset(); }
+
 Result<void> ViewportRenderer::SetState(const SceneState& state) {
   if (!ready()) return Fail(ErrorCode::kInternal, "viewport: no cell");
   return impl_->model->Apply(state, impl_->data.get());
@@ -154,6 +173,10 @@ CameraView ViewportRenderer::camera() const {
   view.elevation_deg = c.elevation;
   view.distance_m = c.distance;
   return view;
+}
+
+double ViewportRenderer::fovy_deg() const {
+  return ready() ? impl_->model->model()->vis.global.fovy : 45.0;
 }
 
 void ViewportRenderer::Orbit(double dx, double dy) {
@@ -213,6 +236,35 @@ void ViewportRenderer::Draw(int x, int y, int width, int height) {
           for (int c = 0; c < 3; ++c) geom.rgba[c] = 0.4f * geom.rgba[c] + 0.6f * amber[c];
           geom.emission = 0.35f;
         }
+      }
+    }
+    // Highlights: whole robots (links, gripper, pedestal), parts, the table.
+    for (int g = 0; g < s.mjscene.ngeom && !highlights_.empty(); ++g) {
+      mjvGeom& geom = s.mjscene.geoms[g];
+      if (geom.objtype != mjOBJ_GEOM || geom.objid < 0) continue;
+      const int body = m->geom_bodyid[geom.objid];
+      const char* gname = mj_id2name(m, mjOBJ_GEOM, geom.objid);
+      for (const SceneHighlight& h : highlights_) {
+        bool hit = false;
+        switch (h.kind) {
+          case SceneHighlight::Kind::kRobot:
+            hit = s.body_arm[body] == h.index ||
+                  (gname && h.index >= 0 && h.index < static_cast<int>(s.scene.robots.size()) &&
+                   std::string(gname).starts_with("robot:" + s.scene.robots[h.index].name + "/"));
+            break;
+          case SceneHighlight::Kind::kPart:
+            hit = h.index >= 0 && h.index < static_cast<int>(s.part_body.size()) &&
+                  s.part_body[h.index] == body;
+            break;
+          case SceneHighlight::Kind::kTable:
+            hit = body == s.table_body;
+            break;
+        }
+        if (!hit) continue;
+        for (int c = 0; c < 3; ++c) {
+          geom.rgba[c] = static_cast<float>(0.3 * geom.rgba[c] + 0.7 * h.color[c]);
+        }
+        geom.emission = 0.45f;
       }
     }
     for (const SceneArrow& arrow : arrows_) {

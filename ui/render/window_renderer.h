@@ -33,6 +33,15 @@ struct SceneMarker {
   Rgba color = {0.1, 0.6, 0.9, 0.6};  ///< Colour (translucent).
 };
 
+/// Something of the scene drawn in a colour (e.g. the robot that could not reach, the bodies
+/// that collided), glowing so it shows on any colour.
+struct SceneHighlight {
+  enum class Kind { kPart, kRobot, kTable };
+  Kind kind = Kind::kPart;              ///< What it is.
+  int index = -1;                       ///< Part or robot index in the scene; unused for the table.
+  Rgba color = {0.95, 0.15, 0.1, 1.0};  ///< Colour it is tinted towards.
+};
+
 /// How the viewport draws: antialiased with shadows, or plain (several times faster under
 /// software GL: no multisampling, no shadow pass).
 enum class DrawQuality { kFine, kFast };
@@ -76,6 +85,13 @@ class ViewportRenderer {
   /// Per robot (scene order), a colour the robot's end effector (gripper body, fingers, cup) is
   /// tinted with, e.g. its wrench utilisation during playback; absent or nullopt: its own colours.
   void set_gripper_tints(std::vector<std::optional<Rgba>> tints) { tints_ = std::move(tints); }
+  /// Whole robots, parts or the table tinted (drawn after the gripper tints and the selection).
+  void set_highlights(std::vector<SceneHighlight> highlights) {
+    highlights_ = std::move(highlights);
+  }
+  /// Forgets the cell (an empty project that cannot be drawn): nothing is drawn until the next
+  /// Build succeeds.
+  void Clear();
 
   /// Mouse camera moves, in fractions of the viewport height.
   void Orbit(double dx, double dy);
@@ -85,6 +101,8 @@ class ViewportRenderer {
   void ResetCamera();
   /// The camera as it stands (azimuth, elevation [deg], distance [m], look-at point).
   CameraView camera() const;
+  /// The free camera's vertical field of view [deg] (45 before any cell).
+  double fovy_deg() const;
 
  private:
   struct Impl;
@@ -93,6 +111,7 @@ class ViewportRenderer {
   std::vector<SceneArrow> arrows_;
   std::vector<SceneMarker> markers_;
   std::vector<std::optional<Rgba>> tints_;
+  std::vector<SceneHighlight> highlights_;
   DrawQuality quality_ = DrawQuality::kFine;
 };
 
