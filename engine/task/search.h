@@ -82,6 +82,14 @@ class TaskSearch {
   /// backward abstraction built from `s` at the widest resolution (tests: admissibility).
   int StartHeuristic(int step, int next_step, const SymState& s);
 
+  /// True when some robot can pick `node` at location `loc` with one of its first `max_grasps`
+  /// grasps (the search's cheap pick checks).
+  bool CanBePicked(int node, int loc, int max_grasps);
+  /// Why no robot picks `node` at `loc`: the first check that each of the robots' first
+  /// `max_grasps` grasps fails, counted, e.g. "no grasp of 'x' can be taken where it rests (every
+  /// one of the 80 robot grasps: gripper into the table)".
+  std::string PickCensus(int node, int loc, int max_grasps);
+
   long long expansions() const { return expansions_; }
   int widenings() const { return widenings_; }
   double search_seconds() const { return search_s_; }
@@ -163,6 +171,7 @@ class TaskSearch {
                          const std::unordered_set<std::uint64_t>& forbidden, long long node_budget,
                          int g0, int max_cost, std::vector<int>& path);
   bool CheapPick(int robot, int node, int loc, int grasp);
+
   bool CheapPlace(int robot, int node, int loc, int grasp);
   bool CheapAssemble(const SymState& s, const Milestone& m);
   /// `node` resting at location `loc` leaves every robot room at home (cached).
