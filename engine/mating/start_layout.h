@@ -15,14 +15,14 @@ struct StartOverlap {
   double depth_m = 0.0;  ///< How deep the deepest point of one lies inside the other [m].
 };
 
-/// The pairs of parts that overlap by more than `touch_depth_m` with part p at X_WP[p]: FCL finds
-/// the pairs whose surfaces meet (or one inside the other); the depth is the deepest vertex or
-/// surface sample of either inside the other.
+/// The pairs of parts that overlap by more than `touch_depth_m` with part p at X_WP[p]: of the
+/// pairs whose boxes overlap, the depth is that of the deepest vertex, surface sample or point a
+/// little inside the surface of either inside the other (PenetrationDepth both ways).
 std::vector<StartOverlap> StartOverlaps(AssemblyGeometry& geometry, const std::vector<Iso3>& X_WP,
                                         double touch_depth_m);
 
-/// How deep part `a` at X_a reaches into part `b` at X_b [m]: the deepest of a's vertices and
-/// surface samples inside b (0 when none is).
+/// How deep part `a` at X_a reaches into part `b` at X_b [m]: the deepest of a's vertices, surface
+/// samples and points 0.5 and 2 mm inside its surface inside b (0 when none is).
 double PenetrationDepth(AssemblyGeometry& geometry, int a, const Iso3& X_a, int b,
                         const Iso3& X_b);
 
