@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 
 namespace wrap {
@@ -84,10 +85,12 @@ void ReportPaths(const Project& project, const AssemblyTree& tree, const Assembl
              "they are mated)";
     } else {
       msg += "; free directions: ";
-      const size_t shown = std::min<size_t>(sg.free_axes.size(), 4);
-      for (size_t i = 0; i < shown; ++i) {
-        msg += (i ? ", " : "") + FormatDirection(sg.free_axes[i]);
-      }
+      std::vector<Vec3> free = sg.free_axes;
+      std::stable_sort(free.begin(), free.end(), [](const Vec3& a, const Vec3& b) {
+        return AxisPreference(a) > AxisPreference(b);
+      });
+      const size_t shown = std::min<size_t>(free.size(), 4);
+      for (size_t i = 0; i < shown; ++i) msg += (i ? ", " : "") + FormatDirection(free[i]);
       if (sg.free_axes.size() > shown) {
         msg += " (and " + std::to_string(sg.free_axes.size() - shown) + " more)";
       }
@@ -118,6 +121,7 @@ StepGeometry CheckStep(const Project& project, const AssemblyTree& tree, Assembl
                     .count();
   if (sg.blocked()) {
     InsertionPath path = StepInsertionPath(project, tree, s, -1);
+    path.min_step_m = 5e-4;  // a search over many directions: coarser steps
     sg.free_axes = FreeAxes(g, path, CandidateAxes(graph, moved, base, options.sphere_axes));
   }
   return sg;

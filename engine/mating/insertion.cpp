@@ -9,7 +9,6 @@ namespace wrap {
 
 namespace {
 
-constexpr double kMinStep_m = 1e-4;       // conservative advancement never steps less
 constexpr double kSameAxisCos = 0.99863;  // cos 3 deg
 
 // The world whose meshes are inset so that an intersection means more than `allowed` overlap.
@@ -66,11 +65,11 @@ PathHit Sweep(AssemblyGeometry& g, const InsertionPath& path, double from, doubl
     const double remaining = std::abs(to - s);
     const double d = PoseAndMeasure(g, world, path, s, remaining + 1e-3, &hit, stats);
     if (hit.blocked || remaining <= 0.0) return hit;
-    double step = std::max(d, kMinStep_m);
+    double step = std::max(d, path.min_step_m);
     // Do not step over the edge of the interference band: the allowance changes there.
     const double band = path.interference_travel_m;
     if ((s - band) * (s + sign * step - band) < 0.0) step = std::abs(band - s);
-    if (step <= 0.0) step = kMinStep_m;
+    if (step <= 0.0) step = path.min_step_m;
     s = sign > 0 ? std::min(to, s + step) : std::max(to, s - step);
   }
 }
@@ -151,6 +150,12 @@ std::optional<PartOverlap> OverlapBeyond(AssemblyGeometry& g, const std::vector<
     }
   }
   return std::nullopt;
+}
+
+double AxisPreference(const Vec3& axis) {
+  const double down = -axis.z();
+  const bool aligned = axis.cwiseAbs().maxCoeff() > 0.999;
+  return (down > 0.5 ? 2.0 : down > -0.5 ? 1.0 : 0.0) + (aligned ? 0.5 : 0.0) + 0.1 * down;
 }
 
 std::string FormatDirection(const Vec3& d) {

@@ -24,6 +24,9 @@ struct InsertionPath {
   double interference_travel_m = 1e-3;  ///< Final travel where interference is allowed [m].
   double interference_depth_m = 5e-4;   ///< Overlap allowed there [m].
   double touch_depth_m = 2e-4;          ///< Overlap read as touching elsewhere [m].
+  /// The least step of the sweep [m]: a feature thinner than this could be jumped. Validation
+  /// keeps 0.1 mm; a search over many directions may take coarser steps.
+  double min_step_m = 1e-4;
 };
 
 /// Where a path is blocked.
@@ -46,7 +49,8 @@ Iso3 PathPose(const AssemblyGeometry& geometry, const InsertionPath& path, int p
 
 /// Sweeps the path inward, from `length_m` back to the mating pose, with the real meshes (FCL,
 /// surfaces moved inward by half the allowed overlap), by conservative advancement: each step is
-/// the distance the meshes are apart (at least 0.1 mm), so nothing thicker than that is jumped.
+/// the distance the meshes are apart (at least path.min_step_m), so nothing thicker than that is
+/// jumped.
 /// Returns the first overlap met coming in, or not blocked.
 PathHit SweepInsertion(AssemblyGeometry& geometry, const InsertionPath& path,
                        SweepStats* stats = nullptr);
@@ -79,6 +83,11 @@ struct PartOverlap {
 std::optional<PartOverlap> OverlapBeyond(AssemblyGeometry& geometry, const std::vector<int>& set_a,
                                          const std::vector<int>& set_b,
                                          const std::vector<Iso3>& X, double allowed_m);
+
+/// How natural an insertion axis is, higher is better: from above (the moved input comes down,
+/// gravity helps) before level before from below, axis-aligned before oblique. Orders the free
+/// directions in messages and the choices of authoring.
+double AxisPreference(const Vec3& axis);
 
 /// "[0, 0, -1]" or "[0.71, 0, -0.71]": a direction for messages (two decimals, no "-0").
 std::string FormatDirection(const Vec3& d);

@@ -663,10 +663,14 @@ class Simulator {
       const Iso3 X_WM = X_WP[moved.front()] * scene_.parts[moved.front()].X_AP.inverse();
       const Iso3 X_WB = X_WP[base.front()] * scene_.parts[base.front()].X_AP.inverse();
       const double along = -(X_WB.inverse() * X_WM).translation().dot(mating.axis.normalized());
+      // What the geometry allows there, and at least the simulation's own tolerance (a resting
+      // base settles and a weld gives by a fraction of a millimetre).
       const double touch = project_.geometry.touch_depth_m;
-      const double allowed = along <= mating.interference_travel_m + 1e-9
-                                 ? std::max(mating.interference_depth_m, touch)
-                                 : touch;
+      const double allowed =
+          std::max(options_.collision_tolerance_m,
+                   along <= mating.interference_travel_m + 1e-9
+                       ? std::max(mating.interference_depth_m, touch)
+                       : touch);
       const auto o = OverlapBeyond(geometry_, moved, base, X_WP, allowed);
       if (!o) continue;
       Failed(ActionOfInsertion(w.step), "collision",

@@ -109,7 +109,7 @@ INSTANTIATE_TEST_SUITE_P(Examples, ExampleGeometry,
                          ::testing::Values("stool", "half_stool", "chair", "cross", "cross_openarm",
                                            "cube", "cube_2x2x3", "fabrica_beam",
                                            "fabrica_plumbers_block", "fabrica_car"),
-                         [](const auto& info) { return info.param; });
+                         [](const auto& param_info) { return param_info.param; });
 
 }  // namespace
 }  // namespace wrap::cli
