@@ -10,6 +10,8 @@ namespace wrap {
 namespace {
 
 constexpr double kSameAxisCos = 0.99863;  // cos 3 deg
+constexpr double kNear_m = 2e-3;          // nearer than this the sweep takes fixed steps
+constexpr int kDistanceEvery = 16;        // ... with a distance every so many
 
 // The world whose meshes are inset so that an intersection means more than `allowed` overlap.
 CollisionWorld& WorldFor(AssemblyGeometry& g, double allowed_overlap_m) {
@@ -54,20 +56,61 @@ double PoseAndMeasure(AssemblyGeometry& g, CollisionWorld& world, const Insertio
   return least;
 }
 
-// Sweeps s from `from` to `to` (either way), stopping at the first overlap.
+// Poses the moved parts at `s` and asks FCL whether any moved part overlaps a base part (exact,
+// with early exit: cheaper than a distance when the surfaces slide along each other).
+bool PoseAndCollide(AssemblyGeometry& g, CollisionWorld& world, const InsertionPath& path,
+                    double s, PathHit* hit, SweepStats* stats) {
+  for (int p : path.moved) world.SetPose(BodyId{p}, PathPose(g, path, p, s));
+  for (int p : path.base) world.SetPose(BodyId{p}, g.X_AP(p));
+  if (stats) ++stats->poses;
+  for (int m : path.moved) {
+    if (!g.has_mesh(m)) continue;
+    const Aabb box_m = world.body_aabb(BodyId{m});
+    for (int b : path.base) {
+      if (!g.has_mesh(b)) continue;
+      const Aabb box_b = world.body_aabb(BodyId{b});
+      if ((box_m.max.array() < box_b.min.array()).any() ||
+          (box_b.max.array() < box_m.min.array()).any()) {
+        continue;
+      }
+      if (stats) ++stats->pair_tests;
+      if (world.Collide(BodyId{m}, BodyId{b})) {
+        hit->blocked = true;
+        hit->at_m = s;
+        hit->moved_part = m;
+        hit->base_part = b;
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+// Sweeps s from `from` to `to` (either way), stopping at the first overlap. Far from the base,
+// conservative advancement: each step is the distance the meshes are apart. Within kNear_m of
+// it (the surfaces sliding along each other), fixed steps of path.min_step_m with FCL's
+// collision test, and a distance now and then to see whether the input has got clear.
 PathHit Sweep(AssemblyGeometry& g, const InsertionPath& path, double from, double to,
               SweepStats* stats) {
   PathHit hit;
   const double sign = to >= from ? 1.0 : -1.0;
+  const double band = path.interference_travel_m;
   double s = from;
+  int near_steps = -1;  // fixed steps since the last distance; -1: far
   for (;;) {
     CollisionWorld& world = WorldFor(g, AllowedAt(path, s));
     const double remaining = std::abs(to - s);
-    const double d = PoseAndMeasure(g, world, path, s, remaining + 1e-3, &hit, stats);
-    if (hit.blocked || remaining <= 0.0) return hit;
-    double step = std::max(d, path.min_step_m);
+    double step = path.min_step_m;
+    if (near_steps < 0 || near_steps >= kDistanceEvery) {
+      const double d = PoseAndMeasure(g, world, path, s, remaining + 1e-3, &hit, stats);
+      if (hit.blocked || remaining <= 0.0) return hit;
+      near_steps = d > kNear_m ? -1 : 0;
+      step = std::max(d, path.min_step_m);
+    } else {
+      if (PoseAndCollide(g, world, path, s, &hit, stats) || remaining <= 0.0) return hit;
+      ++near_steps;
+    }
     // Do not step over the edge of the interference band: the allowance changes there.
-    const double band = path.interference_travel_m;
     if ((s - band) * (s + sign * step - band) < 0.0) step = std::abs(band - s);
     if (step <= 0.0) step = path.min_step_m;
     s = sign > 0 ? std::min(to, s + step) : std::max(to, s - step);

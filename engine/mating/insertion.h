@@ -24,9 +24,9 @@ struct InsertionPath {
   double interference_travel_m = 1e-3;  ///< Final travel where interference is allowed [m].
   double interference_depth_m = 5e-4;   ///< Overlap allowed there [m].
   double touch_depth_m = 2e-4;          ///< Overlap read as touching elsewhere [m].
-  /// The least step of the sweep [m]: a feature thinner than this could be jumped. Validation
-  /// keeps 0.1 mm; a search over many directions may take coarser steps.
-  double min_step_m = 1e-4;
+  /// The sweep's step near the base [m]: a feature thinner than this could be jumped. Validation
+  /// takes 0.2 mm; a search over many directions may take coarser steps.
+  double min_step_m = 2e-4;
 };
 
 /// Where a path is blocked.
@@ -48,9 +48,9 @@ struct SweepStats {
 Iso3 PathPose(const AssemblyGeometry& geometry, const InsertionPath& path, int part, double s_m);
 
 /// Sweeps the path inward, from `length_m` back to the mating pose, with the real meshes (FCL,
-/// surfaces moved inward by half the allowed overlap), by conservative advancement: each step is
-/// the distance the meshes are apart (at least path.min_step_m), so nothing thicker than that is
-/// jumped.
+/// surfaces moved inward by half the allowed overlap): far from the base by conservative
+/// advancement (each step the distance the meshes are apart), within 2 mm of it by FCL's
+/// collision test every path.min_step_m; nothing thicker than that step is jumped.
 /// Returns the first overlap met coming in, or not blocked.
 PathHit SweepInsertion(AssemblyGeometry& geometry, const InsertionPath& path,
                        SweepStats* stats = nullptr);
