@@ -12,6 +12,8 @@ namespace wrap {
 
 namespace {
 
+constexpr double kUr5eReach_m = 0.85;  // the catalog's UR5e: the layout's reference arm
+
 // A part's footprint at rest: its hull's box in the rest frame T (origin under the COM).
 struct Footprint {
   Eigen::Vector2d lo = Eigen::Vector2d::Zero();
@@ -218,10 +220,21 @@ Result<LayoutReport> LayOutParts(Project& project, const ProjectCheck& check,
   return report;
 }
 
+Table TableFor(const std::string& model) {
+  const RobotModelInfo* info = FindRobotModel(model);
+  const double scale = (info ? info->reach_m : kUr5eReach_m) / kUr5eReach_m;
+  Table t;
+  t.size = Vec3(1.2 * scale, 1.0 * scale, 0.05);
+  return t;
+}
+
 std::vector<Robot> RobotsAroundTable(const Table& table, int count, const std::string& model,
                                      const std::string& end_effector) {
   std::vector<Robot> out;
-  const double ax = 0.45 * std::sqrt(2.0), ay = 0.35 * std::sqrt(2.0);
+  // The corners of a rectangle that scales with the arm's reach (a UR5e's: 0.9 x 0.7 m).
+  const RobotModelInfo* info = FindRobotModel(model);
+  const double scale = (info ? info->reach_m : kUr5eReach_m) / kUr5eReach_m;
+  const double ax = 0.45 * scale * std::sqrt(2.0), ay = 0.35 * scale * std::sqrt(2.0);
   for (int k = 0; k < count; ++k) {
     const double angle = std::numbers::pi / 4 + 2.0 * std::numbers::pi * k / count;
     const double x = table.center_xy.x() + ax * std::cos(angle);

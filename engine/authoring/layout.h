@@ -39,9 +39,13 @@ Result<LayoutReport> LayOutParts(Project& project, const ProjectCheck& check,
                                  const std::filesystem::path& project_file,
                                  const LayoutOptions& options = {});
 
+/// The table for robots of `model`: 1.2 x 1.0 m for a UR5e, scaled with the arm's reach.
+Table TableFor(const std::string& model);
+
 /// `count` robots of `model` with `end_effector` around the table: on the ellipse through the
-/// corners of a 0.9 x 0.7 m rectangle (4 robots: those corners) centred on the table, the
-/// first at 45 degrees, each facing the centre, on the table top.
+/// corners of a rectangle centred on the table (4 robots: its corners), 0.9 x 0.7 m for a UR5e,
+/// scaled with the arm's reach; the first at 45 degrees, each facing the centre, on the table
+/// top.
 std::vector<Robot> RobotsAroundTable(const Table& table, int count, const std::string& model,
                                      const std::string& end_effector);
 

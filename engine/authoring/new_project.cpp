@@ -71,6 +71,8 @@ void AddParts(const MeshIntake& in, const fs::path& output, Project& p) {
 
 // The DAG: one step per proposed step, its inputs the nodes holding exactly its part sets.
 Result<void> AddSteps(const ProposedSequence& seq, const NewProjectOptions& options, Project& p) {
+  const EndEffectorInfo* ee = FindEndEffector(options.end_effector);
+  const bool options_vacuum = ee != nullptr && ee->kind == EndEffectorKind::kVacuum;
   std::map<std::vector<int>, std::string> node;  // part set -> node name
   for (size_t i = 0; i < p.parts.size(); ++i) node[{static_cast<int>(i)}] = p.parts[i].name;
   for (size_t k = 0; k < seq.steps.size(); ++k) {
@@ -89,8 +91,16 @@ Result<void> AddSteps(const ProposedSequence& seq, const NewProjectOptions& opti
     step.mating.base = node[base];
     step.mating.axis = s.axis_A;
     step.mating.force_N = options.force_N;
-    step.mating.transverse_fraction = 0.1;
-    step.mating.offset_m = 0.005;
+    // The robust check's noise (paper §IV-A): 10% transverse force and 5 mm of offset for a
+    // two-finger grip; none for suction, which transmits only its axial force while mating
+    // (the paper's vacuum experiments carry no noise either).
+    if (options_vacuum) {
+      step.mating.transverse_fraction = 0.0;
+      step.mating.offset_m = 0.0;
+    } else {
+      step.mating.transverse_fraction = 0.1;
+      step.mating.offset_m = 0.005;
+    }
     std::vector<int> joined = moved;
     joined.insert(joined.end(), base.begin(), base.end());
     std::sort(joined.begin(), joined.end());
@@ -180,7 +190,7 @@ Result<NewProjectResult> NewProject(const std::vector<fs::path>& meshes, const f
   p.description = "Made by wrap new from " + std::to_string(n) + " meshes (" +
                   ToString(intake->unit) + "): the DAG by assembly-by-disassembly, initial poses " +
                   "from stable placements a robot can pick.";
-  p.table.size = Vec3(1.2, 1.0, 0.05);
+  p.table = TableFor(options.robot_model);
   p.planner.grasps = options.grasps;
   AddParts(*intake, output, p);
   if (auto ok = AddSteps(seq, options, p); !ok) return std::unexpected(ok.error());
