@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "geometry/mesh_export.h"
 
 namespace wrap::cli {
 namespace {
@@ -89,6 +90,47 @@ TEST(GeometryCli, InfoPrintsTheContactGraphAndInsertionPaths) {
   EXPECT_NE(r.out.find("seat - leg1"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("seat+leg1             free over 30.0 mm along +z"), std::string::npos)
       << r.out;
+}
+
+// A 2 mm plate lying flat on the table: a two-finger gripper would have to put a finger under it
+// (the plate is wider than the stroke across its face), so no grasp clears the table: a warning
+// that says so, by the planner's own pick checks.
+TEST(GeometryCli, PartThatNoGraspCanTakeFromTheTableIsAWarning) {
+  const fs::path dir = fs::temp_directory_path() / "wrap_geometry_cli_plate";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ASSERT_TRUE(WriteStl(dir / "block.stl", BoxMesh(Vec3(-0.03, -0.03, 0), Vec3(0.03, 0.03, 0.04))));
+  ASSERT_TRUE(WriteStl(dir / "plate.stl", BoxMesh(Vec3(-0.05, -0.05, 0.04), Vec3(0.05, 0.05, 0.042))));
+  const json project = json::parse(R"({
+    "format": "wrap-project", "version": 1, "name": "plate",
+    "parts": [
+      {"name": "block", "mesh": "block.stl", "initial_pose": {"xyz": [-0.15, 0, 0.75]}},
+      {"name": "plate", "mesh": "plate.stl", "initial_pose": {"xyz": [0.15, 0, 0.71]}}
+    ],
+    "steps": [{"name": "block+plate", "inputs": ["block", "plate"],
+               "mating": {"moved": "plate", "base": "block", "axis": [0, 0, -1]}}],
+    "robots": [
+      {"name": "a", "model": "ur5e", "end_effector": "robotiq_2f85",
+       "base_pose": {"xyz": [0.45, 0.35, 0.75], "rpy_deg": [0, 0, -142]}},
+      {"name": "b", "model": "ur5e", "end_effector": "robotiq_2f85",
+       "base_pose": {"xyz": [-0.45, -0.35, 0.75], "rpy_deg": [0, 0, 38]}}
+    ]})");
+  std::ofstream(dir / "plate.json") << project.dump(2);
+  const CliRun v = Wrap({"validate", (dir / "plate.json").string()});
+  EXPECT_EQ(v.code, 0) << v.err;  // a warning, not an error
+  EXPECT_NE(v.err.find("parts[1].initial_pose: warning: no grasp of 'plate' can be taken where it "
+                       "rests (every one of the"),
+            std::string::npos)
+      << v.err;
+  EXPECT_NE(v.err.find("gripper into the table)"), std::string::npos) << v.err;
+  EXPECT_EQ(v.err.find("'block' can be taken"), std::string::npos) << v.err;
+  // The planner names the same blocker first, before any count of failed checks.
+  const CliRun plan = Wrap({"plan", (dir / "plate.json").string(), "--task-only"});
+  EXPECT_EQ(plan.code, 1) << plan.out << plan.err;
+  const std::string words = plan.out + plan.err;
+  const size_t blocker = words.find("no grasp of 'plate' can be taken where it rests");
+  EXPECT_NE(blocker, std::string::npos) << words;
+  EXPECT_LT(blocker, words.find("failed ")) << words;
 }
 
 // Every example project is consistent with its meshes: no error, no warning.
