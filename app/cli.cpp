@@ -175,6 +175,31 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   bench_merge->add_flag("--partial", bench_args.partial,
                         "Merge although shards are missing or unfinished (the report says which)");
 
+  NewArgs new_args;
+  CLI::App* new_cmd = app.add_subcommand(
+      "new", "Make a project from an assembly's meshes (one file per part, in assembled "
+             "positions): the DAG, axes, roles, robots and an initial layout from the geometry");
+  new_cmd->add_option("MESH", new_args.meshes, "Mesh files, or folders of them")->required();
+  new_cmd->add_option("-o,--output", new_args.output, "Project file to write (.json)")->required();
+  new_cmd->add_option("--unit", new_args.unit, "Unit of the mesh files: auto, mm, cm or m")
+      ->default_val("auto");
+  new_cmd->add_option("--robots", new_args.robots, "Robots around the table")->default_val(4);
+  new_cmd->add_option("--robot-model", new_args.robot_model, "Catalog robot model")
+      ->default_val("ur5e");
+  new_cmd->add_option("--end-effector", new_args.end_effector, "Catalog end effector")
+      ->default_val("robotiq_2f85");
+  new_cmd->add_option("--force", new_args.force_N, "Mating force of every step [N]")
+      ->default_val(10.0);
+  new_cmd->add_option("--name", new_args.name, "Project name (default: the output's stem)");
+
+  SuggestArgs suggest_args;
+  CLI::App* suggest = app.add_subcommand(
+      "suggest", "Check a project against its meshes and propose fixes (free axes, roles, "
+                 "order, initial poses); --apply writes them");
+  suggest->add_option("PROJECT", suggest_args.project, "Project file (.json)")->required();
+  suggest->add_flag("--apply", suggest_args.apply, "Write the edited project (needs -o)");
+  suggest->add_option("-o,--output", suggest_args.output, "Where --apply writes");
+
   // No subcommand: the GUI, optionally on a project, with its headless hooks.
   GuiArgs gui;
   double gui_at = 0.0;
@@ -205,6 +230,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     return Preprocess(pre, out, err);
   }
   if (render->parsed()) return Render(ren, out, err);
+  if (new_cmd->parsed()) return NewCommand(new_args, out, err);
+  if (suggest->parsed()) return SuggestCommand(suggest_args, out, err);
   if (sim->parsed()) return Sim(sim_args, out, err);
   if (bench->parsed()) {
     if (bench_time_option->count() > 0) bench_args.time_limit_s = bench_time_limit;

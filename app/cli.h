@@ -41,6 +41,34 @@ int ReportTrajectoryCheck(const LoadedProject& loaded, const Plan& plan, const s
 /// `wrap info PROJECT`: parts with mass and size, the DAG as a tree, robots and end effectors.
 int Info(const std::string& project, std::ostream& out, std::ostream& err);
 
+/// Arguments of `wrap new`.
+struct NewArgs {
+  std::vector<std::string> meshes;  ///< Mesh files or folders.
+  std::string output;               ///< Project file to write.
+  std::string unit = "auto";        ///< auto, mm, cm or m.
+  int robots = 4;                   ///< Robots around the table.
+  std::string robot_model = "ur5e";
+  std::string end_effector = "robotiq_2f85";
+  double force_N = 10.0;            ///< Mating force [N].
+  std::string name;                 ///< Project name.
+};
+
+/// `wrap new MESH... -o PROJECT`: writes the project (atomically) and prints each decision.
+/// 0 written; 1 no sequence or layout; 2 bad input.
+int NewCommand(const NewArgs& args, std::ostream& out, std::ostream& err);
+
+/// Arguments of `wrap suggest`.
+struct SuggestArgs {
+  std::string project;  ///< Project file.
+  bool apply = false;   ///< Write the edited project.
+  std::string output;   ///< Where.
+};
+
+/// `wrap suggest PROJECT [--apply -o OUT]`: prints the proposed edits; with --apply writes the
+/// edited project to OUT (atomically; the input only when OUT names it). 0 when nothing needs
+/// fixing or the edits were written, 1 when edits are proposed and not applied, 2 bad input.
+int SuggestCommand(const SuggestArgs& args, std::ostream& out, std::ostream& err);
+
 /// Arguments of `wrap preprocess`.
 struct PreprocessArgs {
   std::string project;                ///< Project file.

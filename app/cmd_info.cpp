@@ -58,11 +58,60 @@ void PrintNode(const Project& p, const AssemblyTree& tree, int id, const std::st
   }
 }
 
+
+// "+z" for an axis direction, else "(0.707, 0, -0.707)".
+std::string NormalText(const Vec3& n) { return AxisText(n); }
+
+void PrintContacts(const Project& p, const GeometryReport& g, std::ostream& out) {
+  out << "\nContacts (parts whose surfaces come within " << FormatMm(g.contacts.tolerance_m)
+      << ", assembled; " << g.contacts.contacts.size() << " pairs):\n";
+  for (const Contact& c : g.contacts.contacts) {
+    const Vec3 lo = c.extent_A.min * 1000.0, hi = c.extent_A.max * 1000.0;
+    const Vec3 at = c.centroid_A * 1000.0;
+    char where[160];
+    std::snprintf(where, sizeof where,
+                  "area %.1f mm2 around (%.1f, %.1f, %.1f) mm, extent %.1f x %.1f x %.1f mm",
+                  c.area_m2 * 1e6, at.x(), at.y(), at.z(), hi.x() - lo.x(), hi.y() - lo.y(),
+                  hi.z() - lo.z());
+    out << "  " << Pad(p.parts[c.a].name + " - " + p.parts[c.b].name, 26) << where;
+    if (c.distance_m > 0.0) out << ", gap " << FormatMm(c.distance_m);
+    out << "\n    normals (out of " << p.parts[c.b].name << "):";
+    double total = 0.0;
+    for (const ContactNormal& n : c.normals) total += n.area_m2;
+    for (const ContactNormal& n : c.normals) {
+      out << " " << NormalText(n.n_A) << " " << Fmt("%.0f", 100.0 * n.area_m2 / total) << "%";
+    }
+    out << "\n";
+  }
+  if (g.steps.empty()) return;
+  out << "\nInsertion paths (the moved input swept along its axis against the base):\n";
+  for (const StepGeometry& sg : g.steps) {
+    const Step& step = p.steps[sg.step];
+    out << "  " << Pad(step.name, 22);
+    if (!sg.touch) {
+      out << "inputs do not touch (closest " << FormatMm(sg.inputs.distance_m) << ")";
+    } else if (sg.blocked()) {
+      out << "blocked (see the errors)";
+    } else {
+      out << "free over " << FormatMm(step.mating.approach_m) << " along "
+          << AxisText(step.mating.axis);
+    }
+    out << Fmt(", %.1f ms", sg.sweep_ms) << "\n";
+  }
+}
+
 }  // namespace
 
 int Info(const std::string& project, std::ostream& out, std::ostream& err) {
-  const LoadedProject loaded = LoadChecked(project);
-  if (!ReportLoad(loaded, project, err)) return 2;
+  GeometryReport geometry;
+  const LoadedProject loaded = LoadChecked(project, &geometry);
+  // A project whose only errors are the geometry's is still described (the contacts and paths
+  // say how to fix it); the exit code says it is invalid.
+  const bool valid = ReportLoad(loaded, project, err);
+  const bool describable = loaded.project.has_value() &&
+                           geometry.diagnostics.error_count() ==
+                               loaded.check.diagnostics.error_count();
+  if (!valid && !describable) return 2;
   const Project& p = *loaded.project;
   const ProjectCheck& check = loaded.check;
 
@@ -89,6 +138,7 @@ int Info(const std::string& project, std::ostream& out, std::ostream& err) {
 
   out << "\nAssembly (" << p.steps.size() << " steps, root first; each step: moved onto base):\n";
   if (check.tree) PrintNode(p, *check.tree, check.tree->root, "  ", "", out);
+  PrintContacts(p, geometry, out);
 
   out << "\nRobots (" << p.robots.size() << "):\n";
   for (const Robot& r : p.robots) {
@@ -119,7 +169,7 @@ int Info(const std::string& project, std::ostream& out, std::ostream& err) {
   out << "\nPlanner defaults: " << p.planner.grasps << " grasps"
       << (p.planner.widen_grasps ? " (widened on failure)" : " (fixed)") << ", time limit "
       << Fmt("%.4g", p.planner.time_limit_s) << " s, seed " << p.planner.seed << "\n";
-  return 0;
+  return valid ? 0 : 2;
 }
 
 }  // namespace wrap::cli

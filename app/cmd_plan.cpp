@@ -108,7 +108,8 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
     return 2;
   }
 
-  const LoadedProject loaded = LoadChecked(args.project);
+  GeometryReport geometry;
+  const LoadedProject loaded = LoadChecked(args.project, &geometry);
   if (!ReportLoad(loaded, args.project, err)) return 2;
   const Project& p = *loaded.project;
   const std::uint64_t seed = args.seed.value_or(p.planner.seed);
@@ -145,6 +146,7 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
     return ExitCodeFor(plan.error().code);
   }
   plan->stats.seed = seed;
+  plan->contacts = ToPlanContacts(geometry.contacts);
   const PlanStats& st = plan->stats;
   out << "Preprocessing (t_grasp) " << Fmt("%.2f", st.t_grasp_s) << " s\n";
   if (st.solved) {

@@ -47,7 +47,8 @@ int Sim(const SimArgs& args, std::ostream& out, std::ostream& err) {
   // The plan's own structure first: it is cheap and names the field at fault.
   auto plan = ReadPlanFile(args.plan);
   if (!plan) return Report(plan.error(), err);
-  const LoadedProject loaded = LoadChecked(args.project);
+  GeometryReport geometry;
+  const LoadedProject loaded = LoadChecked(args.project, &geometry);
   if (!ReportLoad(loaded, args.project, err, /*warnings=*/false)) return 2;
   if (!loaded.check.tree) {
     return Report({ErrorCode::kInternal, "the project's assembly tree is missing"}, err);

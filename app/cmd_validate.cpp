@@ -3,11 +3,33 @@
 
 #include "cli.h"
 #include "load.h"
+#include "grasp/preprocess.h"
 #include "task/plan_json.h"
+#include "task/planner.h"
 
 namespace wrap::cli {
 
 namespace {
+
+// Parts that no robot can pick where they start, by the planner's own pick checks on the
+// project's grasp sets: warnings (the planner would say it only when a milestone fails).
+Diagnostics StartPickWarnings(const LoadedProject& loaded, const std::string& project) {
+  Diagnostics out;
+  const Project& p = *loaded.project;
+  PreprocessOptions options;
+  options.project_file = project;
+  RunContext ctx(p.planner.seed);
+  auto pre = Preprocess(p, loaded.check, options, ctx);
+  if (!pre) return out;  // planning will say why; validation has checked what it can
+  TaskPlannerOptions task;
+  task.project_file = project;
+  auto unpickable = UnpickableAtStart(p, loaded.check, *pre, task);
+  if (!unpickable) return out;
+  for (const UnpickablePart& u : *unpickable) {
+    out.Warning(project, "parts[" + std::to_string(u.part) + "].initial_pose", u.why);
+  }
+  return out;
+}
 
 void PrintDiagnostics(const Diagnostics& diags, bool errors_only, std::ostream& err) {
   for (const Diagnostic& d : diags.items) {
@@ -30,7 +52,9 @@ int Validate(const std::string& project, const std::string& plan_file, bool quie
     }
     plan = std::move(*read);
   }
-  const LoadedProject loaded = LoadChecked(project);
+  GeometryReport geometry;
+  LoadedProject loaded = LoadChecked(project, &geometry);
+  if (loaded.ok()) loaded.check.diagnostics.Append(StartPickWarnings(loaded, project));
   const Diagnostics& diags = loaded.check.diagnostics;
   PrintDiagnostics(diags, quiet, err);
   if (!loaded.ok()) {

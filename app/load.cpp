@@ -4,17 +4,19 @@
 #include <ostream>
 
 #include "model/project_io.h"
-#include "robot/robot_check.h"
+#include "mating/project_check.h"
 
 namespace wrap::cli {
 
-LoadedProject LoadChecked(const std::string& project) {
-  // Parse, then the checks the GUI's live validation makes too (CheckProject).
+LoadedProject LoadChecked(const std::string& project, GeometryReport* geometry) {
+  // Parse, then every check the GUI's live validation makes too (CheckProject); the geometry's
+  // only when its report is wanted.
   LoadedProject loaded;
   ProjectParse parse = ReadProjectFile(project);
   loaded.check.diagnostics = std::move(parse.diagnostics);
   if (!parse.project) return loaded;
-  ProjectCheck check = CheckProject(*parse.project, project);
+  ProjectCheck check =
+      CheckProject(*parse.project, project, geometry, {.geometry = geometry != nullptr});
   loaded.check.diagnostics.Append(check.diagnostics);
   loaded.check.parts = std::move(check.parts);
   loaded.check.tree = std::move(check.tree);
@@ -32,6 +34,23 @@ bool ReportLoad(const LoadedProject& loaded, const std::string& project, std::os
     err << project << ": invalid: " << diags.error_count() << " error(s); run 'wrap validate'\n";
   }
   return loaded.ok();
+}
+
+std::vector<PlanContact> ToPlanContacts(const ContactGraph& graph) {
+  std::vector<PlanContact> out;
+  for (const Contact& c : graph.contacts) {
+    PlanContact pc;
+    pc.part_a = c.a;
+    pc.part_b = c.b;
+    pc.distance_m = c.distance_m;
+    pc.area_m2 = c.area_m2;
+    pc.centroid_A = c.centroid_A;
+    pc.extent_min_A = c.extent_A.min;
+    pc.extent_max_A = c.extent_A.max;
+    for (const ContactNormal& n : c.normals) pc.normals.emplace_back(n.n_A, n.area_m2);
+    out.push_back(std::move(pc));
+  }
+  return out;
 }
 
 std::string Fmt(const char* format, double value) {

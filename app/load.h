@@ -5,18 +5,25 @@
 
 #include <string>
 
+#include "mating/check.h"
 #include "model/validate.h"
+#include "task/plan.h"
 
 namespace wrap::cli {
 
-/// Parses the file, then CheckProject (the model's validation and the robot stage's checks).
-LoadedProject LoadChecked(const std::string& project);
+/// Parses the file, then CheckProject: the model's validation, the robot stage's checks and,
+/// when `geometry` is given, the geometry's (contacts, insertion paths, overlaps at the
+/// start), whose diagnostics join the load's and whose report lands in `*geometry`.
+LoadedProject LoadChecked(const std::string& project, GeometryReport* geometry = nullptr);
 
 /// Prints the load's diagnostics to `err` (all of them, or with `warnings` false only when the
 /// project is invalid) and, when it is invalid, a line saying so. Returns loaded.ok(): false
 /// means the subcommand exits 2.
 bool ReportLoad(const LoadedProject& loaded, const std::string& project, std::ostream& err,
                 bool warnings = true);
+
+/// The contact graph as the plan records it.
+std::vector<PlanContact> ToPlanContacts(const ContactGraph& graph);
 
 /// printf-style formatting of one number, e.g. Fmt("%.2f", 1.5).
 std::string Fmt(const char* format, double value);

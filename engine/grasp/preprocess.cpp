@@ -12,7 +12,7 @@
 
 #include "grasp/detail/grasp_sampler.h"
 #include "grasp/detail/gripper_collision.h"
-#include "grasp/detail/mesh_raycaster.h"
+#include "geometry/mesh_query.h"
 #include "grasp/detail/parallel.h"
 #include "robot/catalog.h"
 
@@ -273,13 +273,13 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
   X_AP.push_back(Iso3::Identity());
   // The collision world (FCL's trees, built serially) alongside the parts' raycasters.
   Result<detail::GripperCollision> world = Fail(ErrorCode::kInternal, "not built");
-  std::vector<std::unique_ptr<detail::MeshRaycaster>> rays(num_parts);
+  std::vector<std::unique_ptr<MeshQuery>> rays(num_parts);
   detail::ParallelFor(num_unique + 1, options.parallel, [&](int task) {
     if (task == 0) {
       world = detail::GripperCollision::Build(meshes, X_AP, effectors, ctx);
     } else if (!ctx.ShouldStop()) {
       const int p = unique_parts[task - 1];
-      rays[p] = std::make_unique<detail::MeshRaycaster>(check.parts[p].mesh);
+      rays[p] = std::make_unique<MeshQuery>(check.parts[p].mesh);
     }
   });
   if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp sampling"));

@@ -53,6 +53,10 @@ struct Mating {
   double transverse_fraction = 0.0;  ///< Transverse force bound as a fraction of force_N.
   double offset_m = 0.0;             ///< Bound on the application-point offset [m].
   double approach_m = 0.03;          ///< Straight approach distance along the axis [m].
+  /// The final travel [m] in which the inputs may interfere (snap and press fits): within it the
+  /// geometry checks allow `interference_depth_m` of overlap, before it only touching.
+  double interference_travel_m = 1e-3;
+  double interference_depth_m = 5e-4;  ///< Most overlap allowed in that final travel [m].
   std::optional<WrenchBox> connection_limits;  ///< T_pq in the mating frame; default: project's.
   bool operator==(const Mating&) const = default;
 };
@@ -110,6 +114,16 @@ struct Table {
   bool operator==(const Table&) const = default;
 };
 
+/// How the geometry checks (engine/mating) read the meshes: what counts as touching.
+struct GeometryTolerances {
+  double contact_m = 1e-3;  ///< Surfaces this close touch: the contact graph, and a step's inputs
+                            ///< must touch at the mating pose [m].
+  /// Overlap still read as touching [m]: tessellated curved faces that touch in the CAD model
+  /// cut into each other by their chords' sag.
+  double touch_depth_m = 2e-4;
+  bool operator==(const GeometryTolerances&) const = default;
+};
+
 /// Planner defaults stored with the project (the CLI can override them).
 struct PlannerDefaults {
   int grasps = 20;             ///< Grasp-set size per subassembly and end-effector kind.
@@ -142,6 +156,7 @@ struct Project {
   std::vector<MobileBase> mobile_bases;  ///< Bases robots can be mounted on.
   std::vector<Robot> robots;             ///< The robots around the table.
   Table table;                           ///< The table.
+  GeometryTolerances geometry;           ///< What the geometry checks count as touching.
   PlannerDefaults planner;               ///< Planner defaults.
   bool operator==(const Project&) const = default;
 };

@@ -250,7 +250,8 @@ void ReadMating(Reader& r, const json& j, const std::string& path, Mating& m) {
   if (!r.Object(j, path)) return;
   r.CheckKeys(j, path,
               {"moved", "base", "final_poses", "axis", "force_N", "torque_Nm",
-               "transverse_fraction", "offset_m", "approach_m", "connection_limits"});
+               "transverse_fraction", "offset_m", "approach_m", "interference_travel_m",
+               "interference_depth_m", "connection_limits"});
   r.String(j, path, "moved", m.moved, true);
   r.String(j, path, "base", m.base, true);
   if (const json* fp = r.Member(j, path, "final_poses", false)) {
@@ -269,6 +270,8 @@ void ReadMating(Reader& r, const json& j, const std::string& path, Mating& m) {
   r.Number(j, path, "transverse_fraction", m.transverse_fraction);
   r.Number(j, path, "offset_m", m.offset_m);
   r.Number(j, path, "approach_m", m.approach_m);
+  r.Number(j, path, "interference_travel_m", m.interference_travel_m);
+  r.Number(j, path, "interference_depth_m", m.interference_depth_m);
   if (const json* cl = r.Member(j, path, "connection_limits", false)) {
     WrenchBox box;
     r.WrenchBoxValue(*cl, Join(path, "connection_limits"), box);
@@ -340,6 +343,13 @@ void ReadTable(Reader& r, const json& j, const std::string& path, Table& t) {
   }
   r.Number(j, path, "height", t.height);
   r.Number(j, path, "friction", t.friction);
+}
+
+void ReadGeometry(Reader& r, const json& j, const std::string& path, GeometryTolerances& g) {
+  if (!r.Object(j, path)) return;
+  r.CheckKeys(j, path, {"contact_m", "touch_depth_m"});
+  r.Number(j, path, "contact_m", g.contact_m);
+  r.Number(j, path, "touch_depth_m", g.touch_depth_m);
 }
 
 void ReadPlanner(Reader& r, const json& j, const std::string& path, PlannerDefaults& p) {
@@ -457,7 +467,8 @@ ProjectParse ParseProject(std::string_view json_text, const std::string& file_la
 
   r.CheckKeys(root, "",
               {"format", "version", "name", "description", "paths", "table", "parts", "steps",
-               "connection_limits", "wrench_limits", "mobile_bases", "robots", "planner"});
+               "connection_limits", "wrench_limits", "mobile_bases", "robots", "geometry",
+               "planner"});
   Project p;
   // Every error above inside a field is recorded and parsing goes on; the project is returned
   // so that validation can report the rest.
@@ -476,6 +487,9 @@ ProjectParse ParseProject(std::string_view json_text, const std::string& file_la
     }
     ReadList(r, root, "mobile_bases", false, p.mobile_bases, ReadMobileBase);
     ReadList(r, root, "robots", true, p.robots, ReadRobot);
+    if (const json* j = r.Member(root, "", "geometry", false)) {
+      ReadGeometry(r, *j, "geometry", p.geometry);
+    }
     if (const json* j = r.Member(root, "", "planner", false)) {
       ReadPlanner(r, *j, "planner", p.planner);
     }
@@ -536,6 +550,12 @@ std::string SerializeProject(const Project& p) {
              {"axis", Vec3Json(m.axis)}, {"force_N", m.force_N},
              {"torque_Nm", m.torque_Nm}, {"transverse_fraction", m.transverse_fraction},
              {"offset_m", m.offset_m},   {"approach_m", m.approach_m}};
+    const Mating defaults;
+    if (m.interference_travel_m != defaults.interference_travel_m ||
+        m.interference_depth_m != defaults.interference_depth_m) {
+      mj["interference_travel_m"] = m.interference_travel_m;
+      mj["interference_depth_m"] = m.interference_depth_m;
+    }
     if (!m.final_poses.empty()) {
       ojson fp = ojson::array();
       for (const Pose& pose : m.final_poses) fp.push_back(PoseJson(pose));
@@ -572,6 +592,10 @@ std::string SerializeProject(const Project& p) {
     robots.push_back(j);
   }
   root["robots"] = robots;
+  if (p.geometry != GeometryTolerances{}) {
+    root["geometry"] = ojson{{"contact_m", p.geometry.contact_m},
+                             {"touch_depth_m", p.geometry.touch_depth_m}};
+  }
   root["planner"] = ojson{{"grasps", p.planner.grasps},
                           {"widen_grasps", p.planner.widen_grasps},
                           {"time_limit_s", p.planner.time_limit_s},

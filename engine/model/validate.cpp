@@ -78,6 +78,8 @@ class Checker {
 
   void Run(const ValidationOptions& options) {
     CheckTable();
+    Positive(p_.geometry.contact_m, "geometry.contact_m");
+    NonNegative(p_.geometry.touch_depth_m, "geometry.touch_depth_m");
     CheckNames();
     out_.parts.assign(p_.parts.size(), PartGeometry{});
     if (p_.parts.empty()) Error("parts", "the project needs at least one part");
@@ -303,6 +305,8 @@ class Checker {
       NonNegative(m.transverse_fraction, path + ".transverse_fraction");
       NonNegative(m.offset_m, path + ".offset_m");
       NonNegative(m.approach_m, path + ".approach_m");
+      NonNegative(m.interference_travel_m, path + ".interference_travel_m");
+      NonNegative(m.interference_depth_m, path + ".interference_depth_m");
       for (size_t k = 0; k < m.final_poses.size(); ++k) {
         PoseOk(m.final_poses[k], path + ".final_poses[" + std::to_string(k) + "]");
       }

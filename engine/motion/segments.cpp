@@ -13,6 +13,7 @@
 #include <set>
 #include <utility>
 
+#include "mating/check.h"
 #include "motion/ompl_adapter.h"
 #include "robot/ik.h"
 #include "robot/kinematics.h"
@@ -181,6 +182,9 @@ class Builder {
   // until the input is clear: `goal` (the approach keyframe) gets the holders' joints and the
   // input's pose there, and the insertion skill slides from it. Otherwise `goal` stays.
   void SlideStart(int action, Keyframe& goal);
+  // Whether the insertion of step node `step` stays free of its base over `extra` more travel
+  // back along its axis than its approach (the geometry's sweep on the meshes).
+  bool LongerSlideFree(int step, double extra);
   // An insertion whose moved input touches the table top at `goal` (its approach keyframe or
   // slide start: the input slides along the table into a resting base): the holders come to a
   // pose lift_m above it instead, and `descent` (their waypoints, top to bottom) lowers it
@@ -226,6 +230,7 @@ class Builder {
   bool hover_ = false;    // the carries' goal is a hover pose, not a keyframe: no rebranching
   bool jump_ = false;     // a segment did not start where its robots were (see Push)
   std::mt19937_64 rng_;
+  std::optional<AssemblyGeometry> geometry_;  // the parts' meshes: longer insertion slides
 };
 
 Result<void> Builder::SetScene(const std::vector<double>& openings,
@@ -1200,6 +1205,15 @@ bool Builder::KeyframeAccepts(int robot, const JointVector& q, const Keyframe& k
   return scene_.cell().MinRobotClearance(request).distance >= kMinClearance;
 }
 
+bool Builder::LongerSlideFree(int step, double extra) {
+  if (step < w_.num_parts || !w_.check || !w_.check->tree) return true;
+  if (!geometry_) geometry_.emplace(AssemblyGeometry::FromProject(*w_.project, *w_.check));
+  InsertionPath path =
+      StepInsertionPath(*w_.project, *w_.check->tree, w_.tree->nodes[step].step, -1);
+  path.length_m += extra;
+  return IsPathFree(*geometry_, path);
+}
+
 void Builder::SlideStart(int action, Keyframe& goal) {
   const PlanAction& a = plan_.actions[action];
   if (a.type != ActionType::kAssemble || !a.approach || a.objects.size() < 2) return;
@@ -1221,6 +1235,7 @@ void Builder::SlideStart(int action, Keyframe& goal) {
   std::optional<Keyframe> first_clear;
   double first_extra = 0.0;
   for (double extra : {0.01, 0.02, 0.04, 0.06, 0.09, 0.12}) {
+    if (a.objects.size() >= 3 && !LongerSlideFree(a.objects[2], extra)) break;
     std::vector<std::function<Iso3(double)>> targets;
     for (int r : holders) {
       const Iso3 Xa = Tcp(r, goal.q[r]);

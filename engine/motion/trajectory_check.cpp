@@ -6,10 +6,13 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <utility>
 
 #include "geometry/convex_hull.h"
+#include "mating/assembly_geometry.h"
+#include "mating/insertion.h"
 #include "robot/kinematics.h"
 
 namespace wrap {
@@ -111,6 +114,12 @@ class Checker {
   void CheckEvents();
   void CheckDense();
   Cell* CellFor(const std::vector<double>& openings);
+  // The moved input M of an insertion against its base B, both at their poses at this sample,
+  // with the meshes: more overlap than the geometry allows where M is along its path is a
+  // collision (the cell lets the two touch).
+  void CheckInsertionOverlap(double t, int step_node, int M, int B,
+                             const std::map<int, Iso3>& X_WA,
+                             std::set<std::pair<int, int>>& reported);
 
   const TaskWorld& w_;
   const Plan& plan_;
@@ -118,7 +127,36 @@ class Checker {
   TrajectoryCheck out_;
   std::map<std::vector<long long>, Cell> cells_;
   std::vector<std::vector<Vec3>> hull_;  // per part, in the part frame
+  std::optional<AssemblyGeometry> geometry_;  // the parts' meshes, for insertion overlaps
 };
+
+void Checker::CheckInsertionOverlap(double t, int step_node, int M, int B,
+                                    const std::map<int, Iso3>& X_WA,
+                                    std::set<std::pair<int, int>>& reported) {
+  const auto m = X_WA.find(M), b = X_WA.find(B);
+  if (m == X_WA.end() || b == X_WA.end() || step_node < w_.num_parts) return;
+  if (!geometry_) geometry_.emplace(AssemblyGeometry::FromProject(*w_.project, *w_.check));
+  const StepInterface& st = w_.interface(step_node);
+  const Mating& mating = *st.mating;
+  // How far M is back along its path: X_WM = X_WB translated by -s along the axis.
+  const double s = -(b->second.inverse() * m->second).translation().dot(st.axis_A);
+  const double touch = w_.project->geometry.touch_depth_m;
+  const double allowed = s <= mating.interference_travel_m + 1e-9
+                             ? std::max(mating.interference_depth_m, touch)
+                             : touch;
+  std::vector<Iso3> X(w_.num_parts, Iso3::Identity());
+  for (int node : {M, B}) {
+    for (int p : w_.tree->nodes[node].parts) X[p] = X_WA.at(node) * w_.X_AP[p];
+  }
+  const auto o = OverlapBeyond(*geometry_, w_.tree->nodes[M].parts, w_.tree->nodes[B].parts, X,
+                               allowed);
+  if (!o || !reported.insert({-100 - o->part_a, -100 - o->part_b}).second) return;
+  Issue(t, -1, "collision",
+        "'" + geometry_->name(o->part_a) + "' cuts into '" + geometry_->name(o->part_b) +
+            "' deeper than the " + Num(allowed * 1000, "%.1f") + " mm allowed, " +
+            Num(std::max(0.0, s) * 1000, "%.1f") + " mm before its mating pose (inserting " +
+            Node(M) + " into " + Node(B) + ")");
+}
 
 void Checker::CheckKnots(int r) {
   const RobotTrajectory& tr = plan_.trajectories[r];
@@ -295,13 +333,16 @@ void Checker::CheckDense() {
   // Contact windows declared by the plan's skills.
   struct Window {
     double t0, t1;
-    int robot;  // -1: object pair
+    int robot;  // -1: object pair (an insertion: a moves into b)
     int a, b;
+    int step = -1;  // an insertion's step node
   };
   std::vector<Window> windows;
   for (const MotionSegment& m : plan_.segments) {
     if (m.kind == "insert" && m.objects.size() >= 2 && m.action >= 0) {
-      windows.push_back({m.start_s, plan_.actions[m.action].end_s, -1, m.objects[0], m.objects[1]});
+      const PlanAction& action = plan_.actions[m.action];
+      windows.push_back({m.start_s, action.end_s, -1, m.objects[0], m.objects[1],
+                         action.objects.size() >= 3 ? action.objects[2] : -1});
     } else if (m.kind == "approach" && !m.robots.empty() && m.action >= 0) {
       // The gripper touches its object (a suction cup does) from the end of the approach
       // through the grip to the grasp event.
@@ -342,6 +383,7 @@ void Checker::CheckDense() {
     }
     CollisionWorld& cw = cell->world();
     std::vector<int> node_of(n_parts, -1);
+    std::map<int, Iso3> node_X;
     for (auto& [node, thing] : s.things) {
       Iso3 X_WA = thing.X_WA;
       if (!thing.resting && !thing.holders.empty()) {
@@ -363,9 +405,15 @@ void Checker::CheckDense() {
           }
         }
       }
+      node_X[node] = X_WA;
       for (int p : w_.tree->nodes[node].parts) {
         node_of[p] = node;
         cell->SetObjectPose(p, X_WA * w_.X_AP[p]);
+      }
+    }
+    for (const Window& wdw : windows) {
+      if (wdw.robot < 0 && t >= wdw.t0 - 1e-9 && t <= wdw.t1 + 1e-9) {
+        CheckInsertionOverlap(t, wdw.step, wdw.a, wdw.b, node_X, reported);
       }
     }
     auto window = [&](int robot, int a, int b) {

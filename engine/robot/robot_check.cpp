@@ -40,10 +40,4 @@ Diagnostics CheckRobots(const Project& project, const fs::path& project_file) {
   return diags;
 }
 
-ProjectCheck CheckProject(const Project& project, const fs::path& project_file) {
-  ProjectCheck check = ValidateProject(project, project_file);
-  check.diagnostics.Append(CheckRobots(project, project_file));
-  return check;
-}
-
 }  // namespace wrap

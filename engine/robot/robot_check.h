@@ -15,9 +15,4 @@ namespace wrap {
 /// the model's validation; robots that validation already rejected are skipped.
 Diagnostics CheckRobots(const Project& project, const std::filesystem::path& project_file);
 
-/// Every check `wrap validate` makes of a parsed project: the model's ValidateProject, then
-/// CheckRobots. The GUI's live validation and its planner runs call this one function, so a
-/// check added to either appears in both faces.
-ProjectCheck CheckProject(const Project& project, const std::filesystem::path& project_file);
-
 }  // namespace wrap

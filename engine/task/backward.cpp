@@ -323,7 +323,7 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
               mn + "' stay clear of the table (or balance the mating wrench), and held by one " +
               "robot no pair of assembly grasps balances it";
     } else if (!m_pick) {
-      b.why = "no robot can pick '" + mn + "' where it rests";
+      b.why = PickCensus(m.moved, b.loc0[0], res.grasps);
     } else {
       b.why = "no sequence of picks, handovers and set-downs gives a robot one of the " +
               std::to_string(n_asm) + " assembly grasps of '" + mn + "' (of " +

@@ -75,6 +75,8 @@ std::string_view GateName(Gate gate) {
       return "wrench (rest)";
     case Gate::kSkill:
       return "straight approach, retreat or descent";
+    case Gate::kGripperTable:
+      return "gripper into the table";
   }
   return "?";
 }
@@ -918,6 +920,7 @@ EdgeOutcome KeyframeSolver::Validate(const SymState& s, const ContState& c, cons
         case Gate::kIk:
           return 4;
         case Gate::kCollision:
+        case Gate::kGripperTable:
           return 5;
         case Gate::kClearance:
           return 6;

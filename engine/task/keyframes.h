@@ -36,10 +36,11 @@ enum class Gate {
   kWrenchRelease,
   kWrenchRest,
   kSkill,  ///< No room for a straight approach, retreat or descent at the keyframe.
+  kGripperTable,  ///< A grasp that puts the gripper into the table where the object rests.
 };
 /// Words for a gate, e.g. "IK", "collision", "wrench (assembly)".
 std::string_view GateName(Gate gate);
-inline constexpr int kNumGates = 12;
+inline constexpr int kNumGates = 13;
 
 /// Counters and times of the checks.
 struct TaskCounters {

@@ -206,6 +206,19 @@ struct PlanStats {
 };
 
 /// A plan of a project.
+/// Two parts that touch in the assembly, as the geometry checks found them (the project's contact
+/// graph, recorded with the plan for viewers).
+struct PlanContact {
+  int part_a = -1;                    ///< Part index (Plan::parts), a < b.
+  int part_b = -1;                    ///< The other part.
+  double distance_m = 0.0;            ///< Closest distance of the surfaces (0: they meet) [m].
+  double area_m2 = 0.0;               ///< Area within the contact tolerance [m^2].
+  Vec3 centroid_A = Vec3::Zero();     ///< Centre of that area, assembly frame [m].
+  Vec3 extent_min_A = Vec3::Zero();   ///< Its bounding box, assembly frame [m].
+  Vec3 extent_max_A = Vec3::Zero();
+  std::vector<std::pair<Vec3, double>> normals;  ///< Unit normal out of b into a, with its area.
+};
+
 struct Plan {
   std::string project;               ///< Project name.
   std::vector<std::string> robots;   ///< Robot names, Project::robots order.
@@ -218,6 +231,7 @@ struct Plan {
   /// Timed trajectories, one per robot (Project::robots order); empty without motion.
   std::vector<RobotTrajectory> trajectories;
   std::vector<MotionSegment> segments;  ///< How the motion was made, by start time.
+  std::vector<PlanContact> contacts;    ///< The assembly's contact graph (may be empty).
 };
 
 /// Joint positions (and velocities when `qd` is given) of a trajectory at time t, clamped to its

@@ -617,6 +617,32 @@ class PlanReader {
     return m;
   }
 
+  PlanContact ReadContact(const json& e, const std::string& at) const {
+    ExpectObject(e, at);
+    CheckKeys(e, at, {"parts", "distance_m", "area_m2", "centroid", "extent", "normals"});
+    PlanContact c;
+    const json& parts = ExpectArray(Member(e, at, "parts"), Join(at, "parts"));
+    if (parts.size() != 2) Bad(Join(at, "parts"), "expected two part names");
+    c.part_a = PartValue(parts[0], Index(Join(at, "parts"), 0));
+    c.part_b = PartValue(parts[1], Index(Join(at, "parts"), 1));
+    c.distance_m = NonNegative(e, at, "distance_m");
+    c.area_m2 = NonNegative(e, at, "area_m2");
+    c.centroid_A = Vector3(e, at, "centroid");
+    const std::string ext = Join(at, "extent");
+    const json& extent = ExpectObject(Member(e, at, "extent"), ext);
+    CheckKeys(extent, ext, {"min", "max"});
+    c.extent_min_A = Vector3(extent, ext, "min");
+    c.extent_max_A = Vector3(extent, ext, "max");
+    const json& normals = ExpectArray(Member(e, at, "normals"), Join(at, "normals"));
+    for (size_t k = 0; k < normals.size(); ++k) {
+      const std::string n = Index(Join(at, "normals"), k);
+      ExpectObject(normals[k], n);
+      CheckKeys(normals[k], n, {"n", "area_m2"});
+      c.normals.emplace_back(Vector3(normals[k], n, "n"), NonNegative(normals[k], n, "area_m2"));
+    }
+    return c;
+  }
+
  private:
   Plan& plan_;
   std::map<std::string, int> robots_, parts_, nodes_;
@@ -737,7 +763,7 @@ Plan ReadPlan(const json& root) {
     Bad("", "expected a JSON object at the top level, found " + TypeName(root));
   CheckKeys(root, "",
             {"format", "version", "project", "robots", "parts", "nodes", "milestones", "stats",
-             "initial", "actions", "trajectories", "segments"});
+             "initial", "actions", "trajectories", "segments", "contacts"});
   const std::string format = String(root, "", "format");
   if (format != kFormatName) {
     Bad("format", "expected \"" + std::string(kFormatName) + "\", found \"" + format + "\"");
@@ -809,6 +835,12 @@ Plan ReadPlan(const json& root) {
     ExpectArray(*segments, "segments");
     for (size_t i = 0; i < segments->size(); ++i) {
       plan.segments.push_back(reader.ReadSegment((*segments)[i], Index("segments", i)));
+    }
+  }
+  if (const json* contacts = Find(root, "contacts")) {
+    ExpectArray(*contacts, "contacts");
+    for (size_t i = 0; i < contacts->size(); ++i) {
+      plan.contacts.push_back(reader.ReadContact((*contacts)[i], Index("contacts", i)));
     }
   }
   return plan;
@@ -936,6 +968,23 @@ std::string SerializePlan(const Plan& plan) {
     ojson segments = ojson::array();
     for (const MotionSegment& m : plan.segments) segments.push_back(SegmentJson(plan, m));
     doc["segments"] = segments;
+  }
+  if (!plan.contacts.empty()) {
+    ojson contacts = ojson::array();
+    for (const PlanContact& c : plan.contacts) {
+      ojson normals = ojson::array();
+      for (const auto& [n, area] : c.normals) {
+        normals.push_back(ojson{{"n", Vec3Json(n)}, {"area_m2", area}});
+      }
+      contacts.push_back(ojson{{"parts", {NameOr(plan.parts, c.part_a), NameOr(plan.parts, c.part_b)}},
+                               {"distance_m", c.distance_m},
+                               {"area_m2", c.area_m2},
+                               {"centroid", Vec3Json(c.centroid_A)},
+                               {"extent", ojson{{"min", Vec3Json(c.extent_min_A)},
+                                                {"max", Vec3Json(c.extent_max_A)}}},
+                               {"normals", normals}});
+    }
+    doc["contacts"] = contacts;
   }
   // Keys keep the order written here (ordered_json); invalid UTF-8 in names is replaced, never
   // thrown.

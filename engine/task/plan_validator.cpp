@@ -18,6 +18,8 @@
 #include <utility>
 
 #include "geometry/convex_hull.h"
+#include "mating/assembly_geometry.h"
+#include "mating/insertion.h"
 #include "robot/catalog.h"
 #include "robot/cell.h"
 #include "robot/home.h"
@@ -45,6 +47,8 @@ namespace {
 constexpr double kFingerClearanceM = 1e-3;
 // Most colliding pairs reported per keyframe.
 constexpr int kMaxCollisionPairsReported = 4;
+// The validator sweeps an insertion path in steps of this length [m].
+constexpr double kInsertionStep_m = 2.5e-4;
 
 std::string Quote(std::string_view s) { return "'" + std::string(s) + "'"; }
 
@@ -187,6 +191,10 @@ class Validator {
                        const std::map<int, Iso3>& X_WA,
                        const std::vector<std::pair<int, PlanHold>>& holds);
   Cell* CellFor(const std::vector<double>& openings);
+  // The moved input's straight path from its approach pose into its mating pose on B (at X_WB),
+  // swept against B's meshes every kInsertionStep_m: the validator's own sweep (the planner's
+  // is the geometry checks' conservative advancement).
+  void CheckInsertionPath(int index, const Interface& f, const Iso3& X_WB);
 
   // Wrench configurations.
   void AddObject(int node, const Iso3& X_WA, const std::vector<PlanHold>& holders, bool on_table,
@@ -205,6 +213,7 @@ class Validator {
   std::vector<Aabb> box_A_;                // per part: box in A
   std::vector<Interface> interfaces_;      // per node (valid for steps)
   std::map<std::vector<long long>, Cell> cells_;
+  std::optional<AssemblyGeometry> geometry_;  // the parts' meshes, for the insertion sweeps
   bool cells_failed_ = false;
   std::optional<WrenchChecker> checker_;
 
@@ -308,7 +317,37 @@ Result<void> Validator::Setup(const std::filesystem::path& project_file) {
   }
 
   checker_.emplace(WrenchOptions{});
+  geometry_.emplace(AssemblyGeometry::FromProject(project_, check_));
   return {};
+}
+
+void Validator::CheckInsertionPath(int index, const Interface& f, const Iso3& X_WB) {
+  const Mating& mating = f.step->mating;
+  const std::vector<int>& moved = tree_.nodes[f.moved_node].parts;
+  const std::vector<int>& base = tree_.nodes[f.base_node].parts;
+  std::vector<Iso3> X(project_.parts.size(), Iso3::Identity());
+  for (int p : base) X[p] = X_WB * X_AP_[p];
+  const Vec3 axis_W = X_WB.linear() * f.axis_A;
+  const int steps = static_cast<int>(std::ceil(mating.approach_m / kInsertionStep_m));
+  for (int k = steps; k >= 0; --k) {
+    const double s = steps > 0 ? mating.approach_m * k / steps : 0.0;
+    for (int p : moved) {
+      X[p] = X_WB * X_AP_[p];
+      X[p].translation() -= s * axis_W;
+    }
+    const double allowed = s <= mating.interference_travel_m + 1e-12
+                               ? std::max(mating.interference_depth_m,
+                                          project_.geometry.touch_depth_m)
+                               : project_.geometry.touch_depth_m;
+    if (const auto o = OverlapBeyond(*geometry_, moved, base, X, allowed)) {
+      Issue(index, "insertion",
+            "assemble: on its way into its mating pose " + Quote(NodeName(f.moved_node)) +
+                " (part " + Quote(PartName(o->part_a)) + ") cuts " + Mm(s) +
+                " before it into " + Quote(NodeName(f.base_node)) + " (part " +
+                Quote(PartName(o->part_b)) + ") deeper than the " + Mm(allowed) + " allowed");
+      return;
+    }
+  }
 }
 
 Result<void> Validator::CheckInterpretable() const {
@@ -1169,6 +1208,7 @@ void Validator::ReplayAction(int i) {
       } else {
         Issue(i, "pose", "assemble has no approach keyframe");
       }
+      CheckInsertionPath(i, f, X_WB);
       m.allowed_pairs.emplace_back(M, B);
       m.required[M] = {X_WB, "its mating pose on " + Quote(NodeName(B)) + " (X_WM = X_WB)"};
       X = CheckKeyframe(i, "", kf, m);

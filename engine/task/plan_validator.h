@@ -57,7 +57,9 @@ struct PlanIssue {
   int action = -1;
   /// Which check failed: "plan" (names, counts), "precondition" (an action not allowed in the
   /// state, or malformed), "pose" (an object where it may not be, the keyframe's object list, the
-  /// mating or approach pose, a resting object off the table), "joints" (a robot that may not
+  /// mating or approach pose, a resting object off the table), "insertion" (the moved input's straight
+  /// path from its approach pose into its mating pose cuts into the base beyond the geometry's
+  /// allowance), "joints" (a robot that may not
   /// move did), "fk" (a TCP away from its grasp pose), "joint_limits", "collision", "clearance",
   /// "wrench_assembly", "wrench_transport", "wrench_release", "wrench_rest" (an infeasible gate,
   /// with the checker's reason), "incomplete" (the plan does not end with the root assembled,

@@ -5,8 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <set>
 
+#include "mating/check.h"
 #include "robot/cell.h"
 #include "task/keyframes.h"
 #include "task/search.h"
@@ -150,10 +152,38 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
   return true;
 }
 
+// Each step's moved input swept along its axis into its mating pose against the base input's
+// meshes (geometry's sweep, every symmetric final pose); a blocked path fails as bad input.
+Result<void> CheckInsertionPaths(const Project& project, const ProjectCheck& check) {
+  if (!check.tree) return {};
+  AssemblyGeometry geometry = AssemblyGeometry::FromProject(project, check);
+  for (int s = 0; s < static_cast<int>(project.steps.size()); ++s) {
+    const Mating& m = project.steps[s].mating;
+    if (check.tree->Find(m.moved) < 0 || check.tree->Find(m.base) < 0) continue;
+    const int poses = std::max<int>(1, static_cast<int>(m.final_poses.size()));
+    for (int k = 0; k < poses; ++k) {
+      const InsertionPath path =
+          StepInsertionPath(project, *check.tree, s, m.final_poses.empty() ? -1 : k);
+      const PathHit hit = SweepInsertion(geometry, path);
+      if (!hit.blocked) continue;
+      return Fail(ErrorCode::kInvalidInput,
+                  "planner: step '" + project.steps[s].name + "': part '" +
+                      geometry.name(hit.moved_part) + "' of the moved input cuts into part '" +
+                      geometry.name(hit.base_part) + "' " + FormatMm(hit.at_m) +
+                      " before its mating pose along " + FormatDirection(m.axis.normalized()) +
+                      " (wrap validate lists the free directions)");
+    }
+  }
+  return {};
+}
+
 }  // namespace
 
 Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const Preprocessed& pre,
                       const TaskPlannerOptions& options, RunContext& ctx) {
+  // The planner judges every insertion path against the meshes before it plans (its own sweep
+  // of each step, whatever validation said): no plan drives one input through the other.
+  if (auto free = CheckInsertionPaths(project, check); !free) return std::unexpected(free.error());
   const auto start = Clock::now();
   static const std::set<std::string> kVariants = {"wrap",     "optimistic", "flat",
                                                   "counting", "exact",      "fine"};
@@ -332,6 +362,36 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
     st.failure_detail = std::move(detail);
   }
   return plan;
+}
+
+Result<std::vector<UnpickablePart>> UnpickableAtStart(const Project& project,
+                                                      const ProjectCheck& check,
+                                                      const Preprocessed& pre,
+                                                      const TaskPlannerOptions& options,
+                                                      int max_grasps) {
+  auto world_or = BuildTaskWorld(project, check, pre, options.project_file);
+  if (!world_or) return std::unexpected(world_or.error());
+  const TaskWorld& world = *world_or;
+  CellOptions cell_options;
+  cell_options.objects_touch_table = false;
+  auto cell = Cell::Build(world.cell_def, cell_options);
+  if (!cell) return Fail(ErrorCode::kInvalidInput, "planner: " + cell.error().message);
+  TaskTables tables;
+  TaskCounters counters;
+  KeyframeSolver solver(world, tables, options, std::move(*cell), counters);
+  RunContext ctx;
+  TaskSearch search(world, tables, solver, options, ctx, 0, false);
+  const int grasps = max_grasps > 0 ? max_grasps : std::numeric_limits<int>::max();
+  std::vector<int> locations(world.num_parts);
+  for (int p = 0; p < world.num_parts; ++p) {
+    locations[p] = tables.InitialLocation(p, world.initial_X_WA[p]);
+  }
+  std::vector<UnpickablePart> out;
+  for (int p = 0; p < world.num_parts; ++p) {
+    if (search.CanBePicked(p, locations[p], grasps)) continue;
+    out.push_back({p, search.PickCensus(p, locations[p], grasps)});
+  }
+  return out;
 }
 
 }  // namespace wrap

@@ -76,4 +76,21 @@ struct TaskPlannerOptions {
 Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const Preprocessed& pre,
                       const TaskPlannerOptions& options, RunContext& ctx);
 
+/// A part that no robot can pick where it starts.
+struct UnpickablePart {
+  int part = -1;    ///< Index into Project::parts.
+  std::string why;  ///< e.g. "no grasp of 'leg1' can be taken where it rests (every one of the
+                    ///< 80 robot grasps: gripper into the table)".
+};
+
+/// The parts that no robot can pick where they rest at the start, by the planner's own pick
+/// checks (reach, the gripper clear of the table, IK clear of everything, carrying the weight)
+/// over the first `max_grasps` grasps of each robot (every one when 0). For validation's
+/// warnings. Fails like PlanTask's set-up.
+Result<std::vector<UnpickablePart>> UnpickableAtStart(const Project& project,
+                                                      const ProjectCheck& check,
+                                                      const Preprocessed& pre,
+                                                      const TaskPlannerOptions& options,
+                                                      int max_grasps = 0);
+
 }  // namespace wrap

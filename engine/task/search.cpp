@@ -329,7 +329,7 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
     ok = false;
     CheckSubject hit = about;
     hit.hit_table = true;
-    tally_.Add(Gate::kCollision,
+    tally_.Add(Gate::kGripperTable,
                "grasp " + std::to_string(tables_.grasp(grasp).index) + " of '" +
                    world_.tree->nodes[node].name +
                    "' puts the gripper into the table where it rests",
@@ -352,6 +352,61 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
   }
   Remember(key, ok);
   return ok;
+}
+
+bool TaskSearch::CanBePicked(int node, int loc, int max_grasps) {
+  for (int r = 0; r < n_robots_; ++r) {
+    const std::vector<int>& ids = GraspIds(node, r);
+    const int n = std::min<int>(static_cast<int>(ids.size()), max_grasps);
+    for (int k = 0; k < n; ++k) {
+      if (CheapPick(r, node, loc, ids[k])) return true;
+    }
+  }
+  return false;
+}
+
+std::string TaskSearch::PickCensus(int node, int loc, int max_grasps) {
+  // The first check each grasp fails, in CheapPick's order, over every robot.
+  long long tried = 0, reach = 0, table = 0, ik = 0, wrench = 0;
+  const Iso3 X_WA = tables_.location(loc).X_WA;
+  for (int r = 0; r < n_robots_; ++r) {
+    const std::vector<int>& ids = GraspIds(node, r);
+    const int n = std::min<int>(static_cast<int>(ids.size()), max_grasps);
+    for (int k = 0; k < n; ++k) {
+      const int g = ids[k];
+      ++tried;
+      const Iso3 target = solver_.GraspTarget(X_WA, g);
+      if (!solver_.InReach(r, target)) {
+        ++reach;
+      } else if (!solver_.ClearOfTable(r, target, solver_.GraspOpening(g))) {
+        ++table;
+      } else if (std::string why; !solver_.SoloReach(r, {{node, X_WA, true}}, g, &why)) {
+        ++ik;
+      } else if (!CheapPick(r, node, loc, g)) {
+        ++wrench;  // the last of CheapPick's checks: carrying it right after the lift
+      }
+    }
+  }
+  const std::string name = "'" + world_.tree->nodes[node].name + "'";
+  if (tried == 0) return "no robot has a grasp of " + name;
+  std::vector<std::pair<long long, std::string>> reasons = {
+      {table, "gripper into the table"},
+      {reach, "out of reach"},
+      {ik, "no collision-free IK"},
+      {wrench, "too weak to carry it"}};
+  std::stable_sort(reasons.begin(), reasons.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::string out = "no grasp of " + name + " can be taken where it rests (";
+  if (reasons[0].first == tried) {
+    out += "every one of the " + std::to_string(tried) + " robot grasps: " + reasons[0].second;
+  } else {
+    out += "of " + std::to_string(tried) + " robot grasps:";
+    for (const auto& [count, words] : reasons) {
+      if (count > 0) out += " " + std::to_string(count) + " " + words + ",";
+    }
+    out.pop_back();
+  }
+  return out + ")";
 }
 
 bool TaskSearch::HomesClear(int node, int loc) {
@@ -380,7 +435,7 @@ bool TaskSearch::CheapPlace(int robot, int node, int loc, int grasp) {
     ok = false;
     CheckSubject hit = about;
     hit.hit_table = true;
-    tally_.Add(Gate::kCollision,
+    tally_.Add(Gate::kGripperTable,
                "setting '" + world_.tree->nodes[node].name + "' down with grasp " +
                    std::to_string(tables_.grasp(grasp).index) + " puts the gripper into the table",
                hit);

@@ -108,6 +108,13 @@ class TaskSearch {
   /// The failure record's cases of the current tally, blocker first, with the scene `start`
   /// (robots' joints and parts' poses at the milestone's start) and each tried object moved.
   std::vector<FailureCase> Cases(const FailureScene& start) const;
+  /// True when some robot can pick `node` at location `loc` with one of its first `max_grasps`
+  /// grasps (the search's cheap pick checks).
+  bool CanBePicked(int node, int loc, int max_grasps);
+  /// Why no robot picks `node` at `loc`: the first check that each of the robots' first
+  /// `max_grasps` grasps fails, counted, e.g. "no grasp of 'x' can be taken where it rests (every
+  /// one of the 80 robot grasps: gripper into the table)".
+  std::string PickCensus(int node, int loc, int max_grasps);
 
   long long expansions() const { return expansions_; }
   int widenings() const { return widenings_; }
@@ -196,6 +203,7 @@ class TaskSearch {
   /// The failure record's case for one tallied gate.
   FailureCase Case(Gate gate, const FailureScene& start) const;
   bool CheapPick(int robot, int node, int loc, int grasp);
+
   bool CheapPlace(int robot, int node, int loc, int grasp);
   bool CheapAssemble(const SymState& s, const Milestone& m);
   /// `node` resting at location `loc` leaves every robot room at home (cached).

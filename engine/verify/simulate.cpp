@@ -13,6 +13,8 @@
 
 #include "core/frames.h"
 #include "geometry/convex_hull.h"
+#include "mating/assembly_geometry.h"
+#include "mating/insertion.h"
 #include "robot/kinematics.h"
 #include "sim/mjcf.h"
 #include "sim/mujoco_model.h"
@@ -126,9 +128,11 @@ struct DataDeleter {
 
 class Simulator {
  public:
-  Simulator(const Project& project, const CellScene& scene, const AssemblyTree& tree,
-            const Plan& plan, bool keyframes, const SimOptions& options, RunContext& ctx)
+  Simulator(const Project& project, const ProjectCheck& check, const CellScene& scene,
+            const AssemblyTree& tree, const Plan& plan, bool keyframes, const SimOptions& options,
+            RunContext& ctx)
       : project_(project),
+        geometry_(AssemblyGeometry::FromProject(project, check)),
         scene_(scene),
         tree_(tree),
         plan_(plan),
@@ -482,11 +486,10 @@ class Simulator {
       } else if (s.kind == "grip" || s.kind == "retreat") {
         windows_.push_back({s.start_s, s.end_s, s.robots, s.objects, false});
       } else if (s.kind == "insert" && s.objects.size() >= 2) {
-        windows_.push_back({s.start_s,
-                            std::max(s.end_s, end_s),
-                            plan_.actions[s.action].robots,
-                            {s.objects[0], s.objects[1]},
-                            true});
+        const PlanAction& action = plan_.actions[s.action];
+        windows_.push_back({s.start_s, std::max(s.end_s, end_s), action.robots,
+                            {s.objects[0], s.objects[1]}, true,
+                            action.objects.size() >= 3 ? action.objects[2] : -1});
       }
     }
   }
@@ -604,7 +607,10 @@ class Simulator {
     ++report_.collision_checks;
     auto hit = collisions_->Check(q, openings, X_WP, Rules(t));
     if (!hit) return std::unexpected(hit.error());
-    if (!hit->has_value()) return {};
+    if (!hit->has_value()) {
+      CheckInsertionOverlaps(t, X_WP);
+      return {};
+    }
     const detail::CollisionHit& h = **hit;
     auto holder = [&](int p) {
       for (const auto& [node, o] : objects_) {
@@ -639,6 +645,53 @@ class Simulator {
     }
     Failed(robot >= 0 ? ActionOfRobot(robot, t) : CurrentAction(), "collision", detail, t);
     return {};
+  }
+
+  // The two inputs of an insertion under way where MuJoCo has them (the collision rules let them
+  // touch): more overlap than the geometry allows where the moved input is along its path is a
+  // collision naming both parts.
+  void CheckInsertionOverlaps(double t, const std::vector<Iso3>& X_WP) {
+    const double slack = 2.0 * options_.sample_every * model_->opt.timestep;
+    for (const Window& w : windows_) {
+      if (!w.pair || w.step < 0 || w.nodes.size() < 2 || t < w.t0 - slack || t > w.t1 + slack) {
+        continue;
+      }
+      const AssemblyNode& node = tree_.nodes[w.step];
+      const Mating& mating = project_.steps[node.step].mating;
+      const std::vector<int>& moved = tree_.nodes[w.nodes[0]].parts;
+      const std::vector<int>& base = tree_.nodes[w.nodes[1]].parts;
+      const Iso3 X_WM = X_WP[moved.front()] * scene_.parts[moved.front()].X_AP.inverse();
+      const Iso3 X_WB = X_WP[base.front()] * scene_.parts[base.front()].X_AP.inverse();
+      const double along = -(X_WB.inverse() * X_WM).translation().dot(mating.axis.normalized());
+      // What the geometry allows there, and at least the simulation's own tolerance (a resting
+      // base settles and a weld gives by a fraction of a millimetre).
+      const double touch = project_.geometry.touch_depth_m;
+      const double allowed =
+          std::max(options_.collision_tolerance_m,
+                   along <= mating.interference_travel_m + 1e-9
+                       ? std::max(mating.interference_depth_m, touch)
+                       : touch);
+      const auto o = OverlapBeyond(geometry_, moved, base, X_WP, allowed);
+      if (!o) continue;
+      Failed(ActionOfInsertion(w.step), "collision",
+             "'" + scene_.parts[o->part_a].name + "' cuts into '" +
+                 scene_.parts[o->part_b].name + "' deeper than the " + Num(1000 * allowed) +
+                 " mm allowed, " + Num(1000 * std::max(0.0, along)) +
+                 " mm before its mating pose (inserting '" + node.name + "')",
+             t);
+      return;
+    }
+  }
+
+  // The assemble action that builds step node `step`.
+  int ActionOfInsertion(int step) const {
+    for (size_t i = 0; i < plan_.actions.size(); ++i) {
+      const PlanAction& a = plan_.actions[i];
+      if (a.type == ActionType::kAssemble && a.objects.size() >= 3 && a.objects[2] == step) {
+        return static_cast<int>(i);
+      }
+    }
+    return CurrentAction();
   }
 
   // The moment of action i: grips close or open, connections are made.
@@ -1140,6 +1193,7 @@ class Simulator {
   }
 
   const Project& project_;
+  AssemblyGeometry geometry_;  // the parts' meshes: insertion overlaps
   const CellScene& scene_;
   const AssemblyTree& tree_;
   const Plan& plan_;
@@ -1152,6 +1206,7 @@ class Simulator {
     std::vector<int> robots;
     std::vector<int> nodes;
     bool pair = false;  // the two nodes may touch each other too (an insertion)
+    int step = -1;      // an insertion's step node: nodes[0] moves into nodes[1]
   };
   std::vector<Window> windows_;                      // contact windows, from the segments
   std::optional<detail::SimCollisions> collisions_;  // when collisions are judged
@@ -1274,7 +1329,7 @@ Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check
   for (size_t p = 0; p < seen.size(); ++p) {
     if (seen[p] != 1) return bad("initial: part '" + scene->parts[p].name + "' is not placed once");
   }
-  Simulator sim(project, *scene, tree, run, timed.has_value(), options, ctx);
+  Simulator sim(project, check, *scene, tree, run, timed.has_value(), options, ctx);
   auto report = sim.Run();
   if (report) {
     for (std::string& n : notes) report->notes.push_back(std::move(n));

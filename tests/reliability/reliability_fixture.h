@@ -87,7 +87,7 @@ inline nlohmann::json BlocksProject() {
        "initial_pose": {"xyz": [0.1, -0.1, 0.75]}}
     ],
     "steps": [{"name": "base+peg", "inputs": ["base", "peg"],
-               "mating": {"moved": "peg", "base": "base", "axis": [0, 0, 1]}}],
+               "mating": {"moved": "peg", "base": "base", "axis": [0, 0, -1]}}],
     "robots": [
       {"name": "r1", "model": "ur5e", "end_effector": "robotiq_2f85",
        "base_pose": {"xyz": [-0.5, 0, 0.75]}},

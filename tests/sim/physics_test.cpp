@@ -14,6 +14,7 @@
 #include "sim/scene.h"
 #include "sim/mujoco_model.h"
 #include "task/plan_json.h"
+#include "task/plan_validator.h"
 #include "verify/simulate.h"
 
 namespace wrap {
@@ -378,6 +379,63 @@ TEST_F(Sim, PlanWithoutMotionReplaysItsKeyframes) {
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().code, ErrorCode::kInvalidInput);
   EXPECT_NE(bad.error().message.find("trajectories"), std::string::npos);
+}
+
+// The half stool's seat with a plug in the hole of the first leg it takes: the plan (made for the
+// open hole) now pushes that leg through the plug. The independent plan validator refuses the
+// insertion at its assemble action, and the simulation fails with a collision naming both parts.
+TEST_F(Sim, InsertionThroughThePluggedHoleIsRefusedAndCollides) {
+  if (!Use("half_stool")) return;
+  const int assemble = FirstAssembleInTime(plan());
+  ASSERT_GE(assemble, 0);
+  const PlanAction& a = plan().actions[assemble];
+  const AssemblyNode& moved = tree().nodes[a.objects[0]];
+  const AssemblyNode& base = tree().nodes[a.objects[1]];
+  ASSERT_EQ(moved.parts.size(), 1u);
+  const int leg = moved.parts[0];
+  const int seat = base.parts[0];
+  ProjectCheck plugged = p_->lp.check;
+  // The plug: the leg's box (assembled) within the seat's box, in the seat's frame.
+  const Iso3 X_seat = ToIsometry(project().parts[seat].assembled_pose);
+  const Iso3 X_leg = ToIsometry(project().parts[leg].assembled_pose);
+  ASSERT_TRUE(X_seat.linear().isIdentity(1e-12)) << "the seat is modelled in place";
+  const Aabb leg_box = ComputeAabb(Transformed(plugged.parts[leg].mesh, X_seat.inverse() * X_leg));
+  const Aabb seat_box = ComputeAabb(plugged.parts[seat].mesh);
+  const Vec3 lo = leg_box.min.cwiseMax(seat_box.min), hi = leg_box.max.cwiseMin(seat_box.max);
+  ASSERT_TRUE((lo.array() < hi.array()).all()) << "the leg does not reach into the seat";
+  TriangleMesh& mesh = plugged.parts[seat].mesh;
+  const TriangleMesh plug = BoxMesh(lo, hi);
+  const int offset = static_cast<int>(mesh.vertices.size());
+  mesh.vertices.insert(mesh.vertices.end(), plug.vertices.begin(), plug.vertices.end());
+  for (const Eigen::Vector3i& t : plug.triangles) {
+    mesh.triangles.push_back(t + Eigen::Vector3i::Constant(offset));
+  }
+  const std::string leg_name = project().parts[leg].name;
+  const std::string seat_name = project().parts[seat].name;
+
+  PlanValidationOptions vo;
+  vo.check_wrench = false;
+  auto validation = ValidatePlan(project(), plugged, plan(), vo, p_->file);
+  ASSERT_TRUE(validation) << validation.error().message;
+  bool refused = false;
+  for (const PlanIssue& i : validation->issues) {
+    if (i.gate == "insertion" && i.action == assemble) {
+      refused = true;
+      EXPECT_NE(i.message.find("(part '" + leg_name + "') cuts"), std::string::npos) << i.message;
+      EXPECT_NE(i.message.find("(part '" + seat_name + "')"), std::string::npos) << i.message;
+    }
+  }
+  EXPECT_TRUE(refused) << "no insertion issue at action " << assemble;
+
+  RunContext ctx(0);
+  auto report = SimulatePlan(project(), plugged, p_->file, plan(), SimOptions{}, ctx);
+  ASSERT_TRUE(report) << report.error().message;
+  ASSERT_TRUE(report->failure.has_value()) << "holds";
+  EXPECT_EQ(report->failure->reason, "collision") << Verdict(*report);
+  EXPECT_EQ(report->failure->action, assemble) << Verdict(*report);
+  EXPECT_NE(report->failure->detail.find("'" + leg_name + "' cuts into '" + seat_name + "'"),
+            std::string::npos)
+      << Verdict(*report);
 }
 
 // A recorded plan of the paper's cube (tests/sim/data/cube_seed10.plan.json: `wrap plan

@@ -10,7 +10,7 @@
 #include "grasp/preprocess.h"
 #include "model/validate.h"
 #include "pipeline/pipeline.h"
-#include "robot/robot_check.h"
+#include "mating/project_check.h"
 #include "task/planner.h"
 
 namespace wrap::gui {

@@ -7,7 +7,7 @@
 #include <chrono>
 #include <exception>
 
-#include "robot/robot_check.h"
+#include "mating/project_check.h"
 
 namespace wrap::gui {
 

@@ -31,7 +31,7 @@ struct PlanarPatch {
 
 // The planar patches of at least `min_area`, largest first. Where an engineer would put a cup:
 // at the middle of a flat face (on a symmetric part, on the line through its centre of mass).
-std::vector<PlanarPatch> PlanarPatches(const MeshRaycaster& part, double tol, double min_area) {
+std::vector<PlanarPatch> PlanarPatches(const MeshQuery& part, double tol, double min_area) {
   const TriangleMesh& mesh = part.mesh();
   std::vector<PlanarPatch> patches;
   std::vector<double> offsets;
@@ -77,7 +77,7 @@ double AngleBetween(const Vec3& a, const Vec3& b) {
 // point; points within `tol` of it touch. Returns the touching area [m^2], or -1 when the pad
 // cannot reach the contact: something protrudes more than `tol` in front of it, or the ray
 // starts inside material. Returns 0 early once fewer than `min_hits` rays can touch.
-double PadContact(const MeshRaycaster& part, const Vec3& c, const Vec3& in, const Vec3& e_w,
+double PadContact(const MeshQuery& part, const Vec3& c, const Vec3& in, const Vec3& e_w,
                   const Vec3& e_l, double width, double length, double tol, double back, int rays_w,
                   int rays_l, int min_hits) {
   double s_min = std::numeric_limits<double>::infinity();
@@ -124,7 +124,7 @@ std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
                                             const RunContext& ctx) {
   std::vector<GraspCandidate> out;
   const EndEffector& ee = *in.ee;
-  const MeshRaycaster& part = *in.part;
+  const MeshQuery& part = *in.part;
   if (ee.stroke_m <= 0.0 || part.area() <= 0.0) return out;
   const double alpha = std::atan(in.friction);
   const double max_width = ee.stroke_m - 2.0 * options.clearance_m;
@@ -231,7 +231,7 @@ std::vector<GraspCandidate> SampleVacuum(const SamplerInput& in, const VacuumGra
                                          const RunContext& ctx) {
   std::vector<GraspCandidate> out;
   const EndEffector& ee = *in.ee;
-  const MeshRaycaster& part = *in.part;
+  const MeshQuery& part = *in.part;
   const double radius = 0.5 * ee.cup_diameter_m;
   if (radius <= 0.0 || part.area() <= 0.0) return out;
   const double tol = options.flatness_tolerance_m;

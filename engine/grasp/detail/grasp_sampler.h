@@ -7,7 +7,7 @@
 
 #include "core/run_context.h"
 #include "grasp/detail/gripper_collision.h"
-#include "grasp/detail/mesh_raycaster.h"
+#include "geometry/mesh_query.h"
 #include "grasp/grasp.h"
 #include "robot/catalog.h"
 
@@ -26,7 +26,7 @@ struct GraspCandidate {
 /// What one sampling run needs: the part (its raycaster and index into the collision world),
 /// where it sits in A, and the end effector.
 struct SamplerInput {
-  const MeshRaycaster* part = nullptr;  ///< The part's surface, in P.
+  const MeshQuery* part = nullptr;  ///< The part's surface, in P.
   int part_index = -1;                  ///< Index into Project::parts (and the world's parts).
   Iso3 X_AP = Iso3::Identity();         ///< Its assembled pose.
   const EndEffector* ee = nullptr;      ///< The end effector.

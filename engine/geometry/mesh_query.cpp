@@ -1,11 +1,12 @@
-#include "grasp/detail/mesh_raycaster.h"
+#include "geometry/mesh_query.h"
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <numeric>
 
-namespace wrap::detail {
+namespace wrap {
 
 namespace {
 
@@ -46,9 +47,41 @@ double RayTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, c
   return e2.dot(q) * inv;
 }
 
+// Squared distance from p to the box [lo, hi] (0 inside).
+double BoxDistance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  const Vec3 d = (lo - p).cwiseMax(p - hi).cwiseMax(0.0);
+  return d.squaredNorm();
+}
+
+// The point of triangle abc nearest to p (the Voronoi-region walk of Ericson, Real-Time Collision
+// Detection, 5.1.5).
+Vec3 ClosestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + (d1 / (d1 - d3)) * ab;
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  }
+  const double denom = va + vb + vc;
+  if (!(std::abs(denom) > 0.0)) return a;  // degenerate triangle
+  const double v = vb / denom, w = vc / denom;
+  return a + v * ab + w * ac;
+}
+
 }  // namespace
 
-MeshRaycaster::MeshRaycaster(const TriangleMesh& mesh) : mesh_(mesh) {
+MeshQuery::MeshQuery(const TriangleMesh& mesh) : mesh_(mesh) {
   const int n = static_cast<int>(mesh_.triangles.size());
   normals_.resize(n);
   cumulative_area_.resize(n);
@@ -72,7 +105,7 @@ MeshRaycaster::MeshRaycaster(const TriangleMesh& mesh) : mesh_(mesh) {
   if (n > 0) Build(0, n, centroids);
 }
 
-void MeshRaycaster::Build(int begin, int end, std::vector<Vec3>& centroids) {
+void MeshQuery::Build(int begin, int end, std::vector<Vec3>& centroids) {
   // Iterative over an explicit stack: node 0 is the root and already allocated.
   struct Task {
     int node, begin, end, depth;
@@ -179,7 +212,7 @@ void MeshRaycaster::Build(int begin, int end, std::vector<Vec3>& centroids) {
   }
 }
 
-std::optional<RayHit> MeshRaycaster::Cast(const Vec3& origin, const Vec3& dir, double t_min,
+std::optional<RayHit> MeshQuery::Cast(const Vec3& origin, const Vec3& dir, double t_min,
                                           double t_max) const {
   if (mesh_.triangles.empty()) return std::nullopt;
   const Vec3 inv_d(1.0 / dir.x(), 1.0 / dir.y(), 1.0 / dir.z());
@@ -227,7 +260,7 @@ std::optional<RayHit> MeshRaycaster::Cast(const Vec3& origin, const Vec3& dir, d
   return best;
 }
 
-Vec3 MeshRaycaster::SamplePoint(std::mt19937_64& rng, int* triangle) const {
+Vec3 MeshQuery::SamplePoint(std::mt19937_64& rng, int* triangle) const {
   const double u = Uniform01(rng) * total_area_;
   int i = static_cast<int>(std::upper_bound(cumulative_area_.begin(), cumulative_area_.end(), u) -
                            cumulative_area_.begin());
@@ -243,4 +276,94 @@ Vec3 MeshRaycaster::SamplePoint(std::mt19937_64& rng, int* triangle) const {
          r2 * (mesh_.vertices[t[2]] - mesh_.vertices[t[0]]);
 }
 
-}  // namespace wrap::detail
+std::optional<ClosestPoint> MeshQuery::Closest(const Vec3& p, double max_distance) const {
+  if (mesh_.triangles.empty() || !(max_distance >= 0.0)) return std::nullopt;
+  double best2 = max_distance * max_distance;
+  ClosestPoint best;
+  std::array<int, kMaxDepth + 2> stack;
+  int top = 0;
+  if (BoxDistance2(p, nodes_[0].lo, nodes_[0].hi) > best2) return std::nullopt;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (BoxDistance2(p, node.lo, node.hi) > best2) continue;
+    if (node.count > 0) {
+      for (int k = node.left; k < node.left + node.count; ++k) {
+        const Eigen::Vector3i& t = mesh_.triangles[order_[k]];
+        const Vec3 q = ClosestOnTriangle(p, mesh_.vertices[t[0]], mesh_.vertices[t[1]],
+                                         mesh_.vertices[t[2]]);
+        const double d2 = (q - p).squaredNorm();
+        if (d2 <= best2) {
+          best2 = d2;
+          best.point = q;
+          best.triangle = order_[k];
+        }
+      }
+      continue;
+    }
+    const int a = node.left, b = node.left + 1;
+    const double da = BoxDistance2(p, nodes_[a].lo, nodes_[a].hi);
+    const double db = BoxDistance2(p, nodes_[b].lo, nodes_[b].hi);
+    // Visit the nearer child first: it tightens the bound for the farther one.
+    if (da <= db) {
+      if (db <= best2) stack[top++] = b;
+      if (da <= best2) stack[top++] = a;
+    } else {
+      if (da <= best2) stack[top++] = a;
+      if (db <= best2) stack[top++] = b;
+    }
+  }
+  if (best.triangle < 0) return std::nullopt;
+  best.distance = std::sqrt(best2);
+  return best;
+}
+
+int MeshQuery::CountCrossings(const Vec3& origin, const Vec3& dir) const {
+  const Vec3 inv_d(1.0 / dir.x(), 1.0 / dir.y(), 1.0 / dir.z());
+  const double t_max = std::numeric_limits<double>::infinity();
+  std::array<int, kMaxDepth + 2> stack;
+  int top = 0, crossings = 0;
+  double t_enter = 0.0;
+  if (!RayBox(origin, inv_d, nodes_[0].lo, nodes_[0].hi, 0.0, t_max, &t_enter)) return 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (node.count > 0) {
+      for (int k = node.left; k < node.left + node.count; ++k) {
+        const Eigen::Vector3i& t = mesh_.triangles[order_[k]];
+        const double h = RayTriangle(origin, dir, mesh_.vertices[t[0]], mesh_.vertices[t[1]],
+                                     mesh_.vertices[t[2]]);
+        if (h > 0.0) ++crossings;
+      }
+      continue;
+    }
+    for (int child : {node.left, node.left + 1}) {
+      if (RayBox(origin, inv_d, nodes_[child].lo, nodes_[child].hi, 0.0, t_max, &t_enter)) {
+        stack[top++] = child;
+      }
+    }
+  }
+  return crossings;
+}
+
+bool MeshQuery::Contains(const Vec3& p) const {
+  if (mesh_.triangles.empty()) return false;
+  // Directions no CAD edge or face is likely to be parallel to.
+  static const std::array<Vec3, 3> kDirs = {Vec3(0.5773, 0.5774, 0.5774).normalized(),
+                                            Vec3(-0.6123, 0.2041, 0.7638).normalized(),
+                                            Vec3(0.1313, -0.9712, 0.1987).normalized()};
+  int votes = 0;
+  for (int i = 0; i < 3; ++i) {
+    votes += CountCrossings(p, kDirs[i]) % 2;
+    if (votes == 2 || votes + (2 - i) < 2) break;  // decided
+  }
+  return votes >= 2;
+}
+
+double MeshQuery::Depth(const Vec3& p, double max_depth) const {
+  if (!Contains(p)) return 0.0;
+  const std::optional<ClosestPoint> c = Closest(p, max_depth);
+  return c ? c->distance : max_depth;
+}
+
+}  // namespace wrap

@@ -1,5 +1,6 @@
-// Ray casting against one triangle mesh (a bounding-volume hierarchy of boxes) and uniform
-// sampling of its surface: what the grasp samplers ask of a part.
+// Queries against one triangle mesh through a bounding-volume hierarchy of boxes: ray casts,
+// closest points, inside tests, and uniform sampling of its surface. What the grasp samplers ask of
+// a part, and what the geometry checks (contacts, overlaps) ask of two.
 #pragma once
 
 #include <cstdint>
@@ -10,7 +11,7 @@
 #include "core/pose.h"
 #include "geometry/mesh.h"
 
-namespace wrap::detail {
+namespace wrap {
 
 /// A uniform double in [0, 1) from 53 random bits (the same sequence on every standard library).
 inline double Uniform01(std::mt19937_64& rng) {
@@ -23,15 +24,34 @@ struct RayHit {
   int triangle = -1;  ///< Triangle index.
 };
 
-/// A mesh prepared for ray casts and surface sampling. Immutable after construction: share one
+/// The point of a mesh nearest to a query point.
+struct ClosestPoint {
+  double distance = 0.0;     ///< Unsigned distance to the surface [m].
+  Vec3 point = Vec3::Zero();  ///< The nearest surface point [m].
+  int triangle = -1;          ///< The triangle it lies on.
+};
+
+/// A mesh prepared for ray casts, closest points and surface sampling. Immutable after construction: share one
 /// between threads.
-class MeshRaycaster {
+class MeshQuery {
  public:
   /// Copies the mesh and builds the hierarchy (median splits, up to 4 triangles a leaf).
-  explicit MeshRaycaster(const TriangleMesh& mesh);
+  explicit MeshQuery(const TriangleMesh& mesh);
 
   /// The nearest hit with t in (t_min, t_max) of the ray origin + t dir (`dir` unit), or none.
   std::optional<RayHit> Cast(const Vec3& origin, const Vec3& dir, double t_min, double t_max) const;
+
+  /// The nearest surface point to `p` if it lies within `max_distance` [m], else none.
+  std::optional<ClosestPoint> Closest(const Vec3& p, double max_distance) const;
+
+  /// True when `p` lies inside the closed surface: the majority of three ray-parity counts along
+  /// fixed skew directions (a ray grazing an edge miscounts one of them at most). Meaningless for
+  /// an open mesh.
+  bool Contains(const Vec3& p) const;
+
+  /// How deep `p` lies inside the closed surface [m]: its distance to the surface when inside and
+  /// within `max_depth`, 0 when outside (or deeper than `max_depth`: then `max_depth`).
+  double Depth(const Vec3& p, double max_depth) const;
 
   /// A point drawn uniformly over the surface area, with its triangle.
   Vec3 SamplePoint(std::mt19937_64& rng, int* triangle) const;
@@ -51,6 +71,7 @@ class MeshRaycaster {
     int count = 0;  // triangles in a leaf, 0 for an inner node (children left, left + 1)
   };
   void Build(int begin, int end, std::vector<Vec3>& centroids);
+  int CountCrossings(const Vec3& origin, const Vec3& dir) const;
 
   TriangleMesh mesh_;
   std::vector<Vec3> normals_;
@@ -60,4 +81,4 @@ class MeshRaycaster {
   std::vector<Node> nodes_;
 };
 
-}  // namespace wrap::detail
+}  // namespace wrap
