@@ -296,9 +296,15 @@ bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objec
   query.gate = gate;
   query.mode = options_.wrench_mode;
   query.lambda = options_.force_scale;
+  const std::uint64_t hits = checker_.cache_hits();
+  const std::uint64_t solves = checker_.lp_solves();
+  const std::uint64_t pivots = checker_.lp_pivots();
   auto result =
       key != 0 ? checker_.CheckCached(key, config, query) : checker_.CheckCached(config, query);
   counters_.t_lp_s += Seconds(start);
+  counters_.lp_cache_hits += static_cast<long long>(checker_.cache_hits() - hits);
+  counters_.lp_solves += static_cast<long long>(checker_.lp_solves() - solves);
+  counters_.lp_pivots += static_cast<long long>(checker_.lp_pivots() - pivots);
   if (!result) {
     if (reason) *reason = result.error().message;
     return false;

@@ -46,7 +46,10 @@ inline constexpr int kNumGates = 13;
 struct TaskCounters {
   long long validations = 0;
   long long validation_failures = 0;
-  long long lp_checks = 0;
+  long long lp_checks = 0;      ///< Wrench checks asked (cache hits included).
+  long long lp_cache_hits = 0;  ///< ... answered from the checker's cache.
+  long long lp_solves = 0;      ///< LPs solved for the others (a vertex of U each, at least).
+  long long lp_pivots = 0;      ///< Their simplex pivots.
   long long ik_calls = 0;
   long long collision_checks = 0;
   double t_ik_s = 0.0;

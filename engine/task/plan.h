@@ -178,6 +178,8 @@ struct PlanStats {
   long long validation_failures = 0;  ///< ... that failed.
   long long lp_checks = 0;            ///< Wrench checks asked (cache hits included).
   long long lp_cache_hits = 0;        ///< ... answered from the cache.
+  long long lp_solves = 0;            ///< LPs solved for the rest (one per vertex of U, ...).
+  long long lp_pivots = 0;            ///< Their simplex pivots.
   long long ik_calls = 0;             ///< IK queries.
   long long collision_checks = 0;     ///< Cell collision queries.
   int milestones = 0;                 ///< Milestones (assembly steps) planned.

@@ -79,6 +79,8 @@ ojson StatsJson(const PlanStats& s) {
                {"validation_failures", s.validation_failures},
                {"lp_checks", s.lp_checks},
                {"lp_cache_hits", s.lp_cache_hits},
+               {"lp_solves", s.lp_solves},
+               {"lp_pivots", s.lp_pivots},
                {"ik_calls", s.ik_calls},
                {"collision_checks", s.collision_checks},
                {"milestones", s.milestones},
@@ -670,6 +672,8 @@ PlanStats ReadStats(const json& root, const std::string& at) {
              "validation_failures",
              "lp_checks",
              "lp_cache_hits",
+             "lp_solves",
+             "lp_pivots",
              "ik_calls",
              "collision_checks",
              "milestones",
@@ -725,6 +729,8 @@ PlanStats ReadStats(const json& root, const std::string& at) {
   count("validation_failures", s.validation_failures);
   count("lp_checks", s.lp_checks);
   count("lp_cache_hits", s.lp_cache_hits);
+  count("lp_solves", s.lp_solves);
+  count("lp_pivots", s.lp_pivots);
   count("ik_calls", s.ik_calls);
   count("collision_checks", s.collision_checks);
   small("milestones", s.milestones);

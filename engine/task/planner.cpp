@@ -316,6 +316,9 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   st.validations = counters.validations;
   st.validation_failures = counters.validation_failures;
   st.lp_checks = counters.lp_checks;
+  st.lp_cache_hits = counters.lp_cache_hits;
+  st.lp_solves = counters.lp_solves;
+  st.lp_pivots = counters.lp_pivots;
   st.ik_calls = counters.ik_calls;
   st.collision_checks = counters.collision_checks;
   st.t_ik_s = counters.t_ik_s;

@@ -86,6 +86,8 @@ struct WrenchChecker::Impl {
   std::uint64_t misses = 0;
   std::unique_ptr<LpBackend> reference;  // Clp, made when the dense simplex first gives no answer
   std::uint64_t fallbacks = 0;
+  std::uint64_t solves = 0;  // LPs solved (one per vertex, the zero-utilisation variants).
+  std::uint64_t pivots = 0;  // Their simplex pivots.
 
   // The backend's answer, or Clp's when the dense simplex ends without one (infeasible, an
   // iteration limit, an error) on an LP that has an answer by construction (x = 0, s = 0 is
@@ -93,11 +95,15 @@ struct WrenchChecker::Impl {
   // not of the configuration. `full` is the problem with its varying column in place.
   LpStatus SolveVarying(const LpProblem& full, const double* values) {
     const LpStatus status = lp->SolveWithColumn(values, solution);
+    ++solves;
+    pivots += static_cast<std::uint64_t>(solution.iterations);
     return status == LpStatus::kOptimal || status == LpStatus::kUnbounded ? status
                                                                          : SolveReference(full);
   }
   LpStatus SolveFull(const LpProblem& full) {
     const LpStatus status = lp->Solve(full, solution);
+    ++solves;
+    pivots += static_cast<std::uint64_t>(solution.iterations);
     return status == LpStatus::kOptimal || status == LpStatus::kUnbounded ? status
                                                                          : SolveReference(full);
   }
@@ -580,6 +586,8 @@ Result<WrenchCheck> WrenchChecker::CheckCached(std::uint64_t key, const StepConf
 std::uint64_t WrenchChecker::cache_hits() const { return impl_->hits; }
 std::uint64_t WrenchChecker::cache_misses() const { return impl_->misses; }
 std::uint64_t WrenchChecker::lp_fallbacks() const { return impl_->fallbacks; }
+std::uint64_t WrenchChecker::lp_solves() const { return impl_->solves; }
+std::uint64_t WrenchChecker::lp_pivots() const { return impl_->pivots; }
 
 void WrenchChecker::ClearCache() {
   impl_->by_hash.clear();

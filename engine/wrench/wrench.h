@@ -268,6 +268,11 @@ class WrenchChecker {
   /// LPs the dense simplex ended without an answer that has one by construction (a numerical
   /// failure), answered by Clp instead. 0 with the Clp backend.
   std::uint64_t lp_fallbacks() const;
+  /// LPs solved since construction (one per vertex of U checked, plus the zero-utilisation
+  /// variants; the explanation's minimum-violation LPs not counted).
+  std::uint64_t lp_solves() const;
+  /// Simplex pivots of those LPs (bound flips included).
+  std::uint64_t lp_pivots() const;
   /// Forgets every cached answer.
   void ClearCache();
   /// The options.

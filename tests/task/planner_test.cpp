@@ -353,6 +353,23 @@ TEST(PlannerInfeasible, SameProjectPlansWithoutTheWrenchModel) {
   EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
 }
 
+// The LP counters add up: every check is a cache hit or at least one LP (a vertex of U), and the
+// cross asks some questions twice (its arms' grasps repeat across milestones).
+TEST(PlannerStats, WrenchCountersAddUp) {
+  const fs::path file = ProjectFile("cross");
+  const LoadedProject lp = LoadProject(file);
+  ASSERT_TRUE(lp.ok());
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 120.0, {});
+  ASSERT_TRUE(run.plan.has_value());
+  const PlanStats& st = run.plan->stats;
+  ASSERT_TRUE(st.solved) << st.failure;
+  EXPECT_GT(st.lp_checks, 0);
+  EXPECT_GT(st.lp_cache_hits, 0);
+  EXPECT_LT(st.lp_cache_hits, st.lp_checks);
+  EXPECT_GE(st.lp_solves, st.lp_checks - st.lp_cache_hits);
+  EXPECT_GE(st.lp_pivots, st.lp_solves) << "a load factor takes at least one pivot to raise";
+}
+
 TEST(PlannerOptions, UnknownVariantIsRefused) {
   const fs::path file = ProjectFile("half_stool");
   const LoadedProject lp = LoadProject(file);
