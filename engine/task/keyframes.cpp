@@ -326,12 +326,44 @@ std::vector<Mat3> KeyframeSolver::AxisOrientations(const Vec3& axis_A) {
   return out;
 }
 
+bool KeyframeSolver::MatingIncrementFits(int step,
+                                         const std::vector<std::pair<int, int>>& moved_holders,
+                                         const std::vector<std::pair<int, int>>& base_holders,
+                                         std::uint64_t key) {
+  if (options_.wrench_mode != MatingWrenchMode::kFull) return true;
+  const StepInterface& s = world_.interface(step);
+  const WrenchObject objs[2] = {{s.moved, Iso3::Identity(), false, moved_holders},
+                                {s.base, Iso3::Identity(), false, base_holders}};
+  const StepConfiguration config = BuildWrenchConfig(world_, tables_, objs, step);
+  if (!HeldThenMated(config)) return true;  // A relaxation of that check only.
+  ++counters_.lp_checks;
+  const auto start = Clock::now();
+  const std::uint64_t hits = checker_.cache_hits();
+  const std::uint64_t solves = checker_.lp_solves();
+  const std::uint64_t pivots = checker_.lp_pivots();
+  WrenchQuery query;
+  query.gate = WrenchGate::kAssembly;
+  query.mode = options_.wrench_mode;
+  query.lambda = options_.force_scale;
+  auto result = checker_.CheckCached(HashMix(key, 0x6d6174696e67ULL),
+                                     MatingIncrementRelaxation(config), query);
+  counters_.t_lp_s += Seconds(start);
+  counters_.lp_cache_hits += static_cast<long long>(checker_.cache_hits() - hits);
+  counters_.lp_solves += static_cast<long long>(checker_.lp_solves() - solves);
+  counters_.lp_pivots += static_cast<long long>(checker_.lp_pivots() - pivots);
+  return !result || result->feasible;  // An error: no conclusion from the relaxation.
+}
+
 bool KeyframeSolver::AirAssemblyPossible(int step,
                                          const std::vector<std::pair<int, int>>& moved_holders,
                                          const std::vector<std::pair<int, int>>& base_holders,
                                          std::uint64_t key, std::string* reason) {
   const StepInterface& s = world_.interface(step);
-  const std::vector<Mat3> orientations = AxisOrientations(s.axis_A);
+  std::vector<Mat3> orientations = AxisOrientations(s.axis_A);
+  if (!MatingIncrementFits(step, moved_holders, base_holders, key)) {
+    // No orientation holds: orientation 0's full check gives the reason.
+    orientations.resize(1);
+  }
   for (size_t k = 0; k < orientations.size(); ++k) {
     Iso3 X = Iso3::Identity();
     X.linear() = orientations[k];

@@ -131,6 +131,12 @@ class KeyframeSolver {
                            const std::vector<std::pair<int, int>>& base_holders, std::uint64_t key,
                            std::string* reason);
 
+  /// False when the mating load of `step` cannot be added to any holding wrenches of these
+  /// holders in any orientation of the pair (MatingIncrementRelaxation of the "held, then mated"
+  /// check; true when the check is not of that kind). Cached by `key`.
+  bool MatingIncrementFits(int step, const std::vector<std::pair<int, int>>& moved_holders,
+                           const std::vector<std::pair<int, int>>& base_holders, std::uint64_t key);
+
   /// TCP target of a robot holding node (at X_WA) with grasp id.
   Iso3 GraspTarget(const Iso3& X_WA, int grasp_id) const;
   /// Orientation candidates for an object whose insertion axis (in A) is `axis_A`: the axis

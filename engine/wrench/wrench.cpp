@@ -42,6 +42,7 @@
 // |F_t| / (mu F_n). When infeasible, explain.cpp names the binding limits at the worst vertex.
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <limits>
 #include <unordered_map>
 
@@ -597,6 +598,33 @@ void WrenchChecker::ClearCache() {
 }
 
 const WrenchOptions& WrenchChecker::options() const { return impl_->options; }
+
+bool HeldThenMated(const StepConfiguration& config) {
+  for (const WrenchGripper& g : config.grippers) {
+    if (!(g.assembly_limits == g.transport_limits)) return true;
+  }
+  return false;
+}
+
+StepConfiguration MatingIncrementRelaxation(const StepConfiguration& config) {
+  // A total t and a hold h both within [lo, hi] differ by t - h within [lo - hi, hi - lo]
+  // (infinite bounds stay infinite).
+  auto widen = [](WrenchBounds& b) {
+    const Vec6 span = b.upper - b.lower;
+    b.lower = -span;
+    b.upper = span;
+  };
+  StepConfiguration out = config;
+  out.gravity_W = Vec3::Zero();
+  out.tables.clear();
+  if (out.mating) {
+    out.mating->transverse_fraction *= std::numbers::sqrt2 / 2.0;
+    out.mating->offset_m *= std::numbers::sqrt2 / 2.0;
+  }
+  for (WrenchGripper& g : out.grippers) widen(g.transport_limits);
+  for (WrenchConnection& c : out.connections) widen(c.limits);
+  return out;
+}
 
 Result<WrenchCheck> CheckWrench(const StepConfiguration& config, const WrenchQuery& query,
                                 const WrenchOptions& options) {

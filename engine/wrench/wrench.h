@@ -283,6 +283,20 @@ class WrenchChecker {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Whether `config`'s assembly check goes "held, then mated" (a gripper whose assembly box
+/// differs from its transport box: vacuum).
+bool HeldThenMated(const StepConfiguration& config);
+
+/// A relaxation of the "held, then mated" assembly check of `config` that no rigid motion of the
+/// whole configuration changes, for configurations without table supports (parts in the air):
+/// gravity off, and every gripper's transport box and every connection's box widened to the
+/// differences of two wrenches within it ([lower - upper, upper - lower]); assembly boxes as they
+/// are; the transverse and offset bounds of the mating shrunk by 1/sqrt(2) (the square they span
+/// then lies inside the one of every turn of the pair about its axis, wherever the world puts
+/// the square's sides). What the mating load adds to the holding wrenches must fit these,
+/// whatever gravity does, so when the relaxation fails the check fails in every orientation.
+StepConfiguration MatingIncrementRelaxation(const StepConfiguration& config);
+
 /// One-shot check without a cache (builds a checker; use a WrenchChecker in loops).
 Result<WrenchCheck> CheckWrench(const StepConfiguration& config, const WrenchQuery& query = {},
                                 const WrenchOptions& options = {});

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
+#include <string>
 
 #include "wrench/wrench.h"
 
@@ -677,6 +679,114 @@ TEST(WrenchBackends, ClpGivesTheSameAnswerOnTheHandCases) {
       EXPECT_NEAR(a.utilisation, b.utilisation, 1e-7 * (1.0 + a.utilisation));
     }
   }
+}
+
+// The whole configuration turned by R about the world origin (gravity stays down).
+StepConfiguration Turned(const StepConfiguration& c, const Mat3& R) {
+  StepConfiguration out = c;
+  for (WrenchBody& b : out.bodies) b.p_WBcm = R * b.p_WBcm;
+  for (WrenchGripper& g : out.grippers) {
+    g.X_WG.translation() = R * g.X_WG.translation();
+    g.X_WG.linear() = R * g.X_WG.linear();
+  }
+  if (out.mating) {
+    out.mating->axis_W = R * out.mating->axis_W;
+    out.mating->p_WContact = R * out.mating->p_WContact;
+  }
+  return out;
+}
+
+// A peg on a vacuum cup mated into a seat held by fingers, in the air.
+StepConfiguration CupPegIntoHeldSeat(double transverse) {
+  StepConfiguration c;
+  c.bodies.push_back({"peg", 0.5, Vec3(0, 0, 0.2)});
+  c.bodies.push_back({"seat", 1.0, Vec3(0, 0, 0.05)});
+  c.grippers.push_back(MakeGripper("r1", 0, At(Vec3(0, 0, 0.25), RotX(std::numbers::pi)),
+                                   EndEffectorKind::kVacuum, WrenchLimits{}));
+  c.grippers.push_back(
+      MakeGripper("r2", 1, At(Vec3(0, 0, 0.05)), EndEffectorKind::kTwoFinger, WrenchLimits{}));
+  MatingLoad m;
+  m.moved = 0;
+  m.base = 1;
+  m.axis_W = -Vec3::UnitZ();
+  m.p_WContact = Vec3(0, 0, 0.1);
+  m.force_N = 10.0;
+  m.transverse_fraction = transverse;
+  c.mating = m;
+  return c;
+}
+
+// A cup takes no transverse force while mating (paper's vacuum table), so a transverse mating
+// bound fails in every orientation of the pair, and the relaxation says so without gravity.
+TEST(WrenchRelaxation, CupUnderTransverseMatingFailsInEveryOrientation) {
+  const StepConfiguration c = CupPegIntoHeldSeat(0.1);
+  ASSERT_TRUE(HeldThenMated(c));
+  const StepConfiguration relaxed = MatingIncrementRelaxation(c);
+  EXPECT_EQ(relaxed.gravity_W, Vec3::Zero());
+  EXPECT_NEAR(relaxed.mating->transverse_fraction, 0.1 / std::numbers::sqrt2, 1e-15);
+  // Transport boxes widened to the difference of two wrenches within them: 2x a symmetric box.
+  EXPECT_EQ(relaxed.grippers[0].transport_limits.upper, 2.0 * c.grippers[0].transport_limits.upper);
+  EXPECT_EQ(relaxed.grippers[0].assembly_limits, c.grippers[0].assembly_limits);
+  EXPECT_FALSE(MustCheck(relaxed).feasible);
+  for (const Mat3& R : {Mat3(Mat3::Identity()), RotX(std::numbers::pi / 2), RotY(0.7),
+                        RotX(std::numbers::pi), Mat3(RotY(-1.2) * RotX(0.4))}) {
+    EXPECT_FALSE(MustCheck(Turned(c, R)).feasible);
+  }
+  // Along the axis alone it holds, and so does the relaxation.
+  EXPECT_TRUE(MustCheck(CupPegIntoHeldSeat(0.0)).feasible);
+  EXPECT_TRUE(MustCheck(MatingIncrementRelaxation(CupPegIntoHeldSeat(0.0))).feasible);
+}
+
+// The relaxation is necessary: over random pairs in the air (cups and fingers, masses, grasp
+// points, transverse and offset bounds, tilted axes) and random orientations, whenever the full
+// check holds in some orientation, the relaxation holds.
+TEST(WrenchRelaxation, NeverRefusesWhatSomeOrientationHolds) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int held = 0, refused_by_relaxation = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    StepConfiguration c;
+    c.bodies.push_back({"moved", 0.2 + 0.8 * (u(rng) + 1.0), Vec3(0.05 * u(rng), 0.05 * u(rng), 0.15)});
+    c.bodies.push_back({"base", 0.5 + (u(rng) + 1.0), Vec3(0.05 * u(rng), 0.05 * u(rng), 0.0)});
+    for (int b = 0; b < 2; ++b) {
+      const bool cup = b == 0 || u(rng) > 0.3;
+      const Mat3 R = Eigen::AngleAxisd(0.2 * u(rng), Vec3(u(rng), u(rng), 0.0).normalized())
+                         .toRotationMatrix() *
+                     (b == 0 ? RotX(std::numbers::pi) : Mat3(Mat3::Identity()));
+      const Vec3 p = c.bodies[b].p_WBcm + Vec3(0.04 * u(rng), 0.04 * u(rng), b == 0 ? 0.05 : -0.05);
+      c.grippers.push_back(MakeGripper("r" + std::to_string(b), b, At(p, R),
+                                       cup ? EndEffectorKind::kVacuum : EndEffectorKind::kTwoFinger,
+                                       WrenchLimits{}));
+    }
+    MatingLoad m;
+    m.moved = 0;
+    m.base = 1;
+    // Mostly along the cup's z (what a cup can push), sometimes tilted off it.
+    m.axis_W = (c.grippers[0].X_WG.linear().col(2) +
+                (u(rng) > 0.0 ? Vec3::Zero() : Vec3(0.2 * u(rng), 0.2 * u(rng), 0.0)))
+                   .normalized();
+    // On the cup's line mostly (a cup takes no moment while mating), sometimes off it.
+    m.p_WContact = c.grippers[0].X_WG.translation() + 0.07 * m.axis_W +
+                   (u(rng) > 0.0 ? Vec3::Zero() : Vec3(0.01 * u(rng), 0.01 * u(rng), 0.0));
+    m.force_N = 5.0 + 10.0 * (u(rng) + 1.0);
+    m.transverse_fraction = u(rng) > 0.0 ? 0.0 : 0.1 * (u(rng) + 1.0);
+    m.offset_m = u(rng) > 0.0 ? 0.0 : 0.005 * (u(rng) + 1.0);
+    c.mating = m;
+    ASSERT_TRUE(HeldThenMated(c));
+    const bool relaxed = MustCheck(MatingIncrementRelaxation(c)).feasible;
+    for (int k = 0; k < 4; ++k) {
+      const Mat3 R = Eigen::AngleAxisd((k == 0 ? 0.0 : 0.8) * u(rng),
+                                       Vec3(u(rng), u(rng), u(rng)).normalized())
+                         .toRotationMatrix();
+      const bool full = MustCheck(Turned(c, R)).feasible;
+      held += full ? 1 : 0;
+      if (full) EXPECT_TRUE(relaxed) << "trial " << trial << " orientation " << k;
+    }
+    refused_by_relaxation += relaxed ? 0 : 1;
+  }
+  // Both verdicts occur, so the property was exercised.
+  EXPECT_GT(held, 0);
+  EXPECT_GT(refused_by_relaxation, 0);
 }
 
 }  // namespace
