@@ -299,9 +299,8 @@ class Checker {
     // edge); a part whose footprint centre is beyond the edge cannot rest there.
     const Vec3 mid = 0.5 * (lo + hi);
     if (std::abs(mid.x() - c.x()) > half.x() || std::abs(mid.y() - c.y()) > half.y()) {
-      Warning(path, "part " + Quote(part.name) +
-                        " sticks out over the edge of the table "
-                        "(its footprint's centre is beyond it)");
+      Warning(path, "part " + Quote(part.name) + " sticks out over the edge of the table "
+                                                 "(its footprint's centre is beyond it)");
     }
   }
 
