@@ -152,7 +152,7 @@ std::string WithEntityOfLine(const fs::path& path, const std::string& message) {
   if (end == at + 5 || end - at > 15) return message;
   const std::string entity = EntityAtLine(path, std::stol(message.substr(at + 5, end - at - 5)));
   if (entity.empty()) return message;
-  return message.substr(0, end) + " (entity " + entity + ")" + message.substr(end);
+  return message.substr(0, end) + " (near entity " + entity + ")" + message.substr(end);
 }
 
 std::string StepTypeName(const std::string& occt_name) {

@@ -54,6 +54,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -184,9 +185,10 @@ std::optional<Rgba4> ToRgba(const Quantity_ColorRGBA& c) {
   // The file's COLOUR_RGB values are display (sRGB) values; OpenCASCADE holds linear RGB.
   double r = 0, g = 0, b = 0;
   c.GetRGB().Values(r, g, b, Quantity_TOC_sRGB);
-  const Rgba4 rgba = {r, g, b, static_cast<double>(c.Alpha())};
-  for (double v : rgba) {
-    if (!(v >= 0.0 && v <= 1.0)) return std::nullopt;
+  Rgba4 rgba = {r, g, b, static_cast<double>(c.Alpha())};
+  for (double& v : rgba) {
+    if (!std::isfinite(v)) return std::nullopt;
+    v = std::clamp(v, 0.0, 1.0);  // the sRGB conversion's rounding may leave 1 + 1e-16
   }
   return rgba;
 }
@@ -335,7 +337,8 @@ class StepReader {
     if (L.linear().determinant() < 0.0) {
       for (auto& t : own.mesh.triangles) std::swap(t[1], t[2]);
     }
-    solid_colors_.push_back(solid_colors_[static_cast<size_t>(inst.solid)]);
+    const std::optional<Rgba4> color = solid_colors_[static_cast<size_t>(inst.solid)];
+    solid_colors_.push_back(color);
     out_.solids.push_back(std::move(own));
     inst.solid = static_cast<int>(out_.solids.size()) - 1;
     inst.X_AS = Iso3::Identity();
@@ -354,7 +357,9 @@ class StepReader {
     if (product_name.empty()) product_name = "solid";
     std::vector<TopoDS_Shape> bodies;
     for (TopExp_Explorer e(shape, TopAbs_SOLID); e.More(); e.Next()) bodies.push_back(e.Current());
-    // A surface model: closed shells not inside a solid count as solids (if they mesh closed).
+    // A surface model: its shells (those not inside a solid) count as solids when they mesh
+    // closed; open ones are skipped with a warning (a solid that does not mesh closed fails).
+    const size_t first_shell = bodies.size();
     for (TopExp_Explorer e(shape, TopAbs_SHELL, TopAbs_SOLID); e.More(); e.Next()) {
       bodies.push_back(e.Current());
     }
@@ -385,6 +390,13 @@ class StepReader {
       solid.name = UniqueSolidName(name);
       solid.entity = Entity(bodies[k], "");
       auto mesh = MeshOf(bodies[k], solid);
+      if (!mesh && k >= first_shell) {
+        solid_names_.erase(solid.name);
+        out_.warnings.push_back("shell " + Quote(solid.name) +
+                                (solid.entity.empty() ? "" : " (" + solid.entity + ")") +
+                                " is a surface, not a closed solid: skipped");
+        continue;
+      }
       if (!mesh) return std::unexpected(mesh.error());
       solid.mesh = std::move(*mesh);
       solid_colors_.push_back(SolidColor(colors_, bodies[k]));

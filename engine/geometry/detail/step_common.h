@@ -23,7 +23,7 @@ Result<TriangleMesh> CheckClosedSolid(TriangleMesh mesh, const std::string& what
 /// (1-based) that starts with an entity name; empty when there is none.
 std::string EntityAtLine(const std::filesystem::path& path, long line);
 
-/// `message` with " (entity #N)" added after its first "Line N" (OpenCASCADE's syntax errors
+/// `message` with " (near entity #N)" added after its first "Line N" (OpenCASCADE's syntax errors
 /// name only the line).
 std::string WithEntityOfLine(const std::filesystem::path& path, const std::string& message);
 
