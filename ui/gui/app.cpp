@@ -41,7 +41,8 @@ fs::path RecentFilesPath() {
 bool IsMeshFile(const fs::path& p) {
   std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  for (const char* m : {".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".3mf", ".dae"}) {
+  for (const char* m :
+       {".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".3mf", ".dae", ".step", ".stp"}) {
     if (ext == m) return true;
   }
   return false;
@@ -93,7 +94,8 @@ class App {
       } else if (fs::path(f).extension() == ".urdf") {
         robots_.AddUrdf(s_, f);
       } else {
-        s_.Notify("Dropped file not recognised (a mesh, a robot .urdf or a project .json): " + f);
+        s_.Notify("Dropped file not recognised (a mesh or STEP file, a robot .urdf or a project "
+                  ".json): " + f);
       }
     }
     TakePlan();
