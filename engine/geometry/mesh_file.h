@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "core/result.h"
 #include "geometry/mesh.h"
@@ -24,10 +25,17 @@ struct MeshFileOptions {
   std::filesystem::path cache_dir;  ///< STEP only: folder of cached tessellations (may be empty).
 };
 
+/// What LoadMeshFile read.
+struct MeshFile {
+  TriangleMesh mesh;                  ///< [m], in the part frame.
+  std::vector<std::string> warnings;  ///< STEP: what the file held that was skipped (a product
+                                      ///< without a solid, an open surface).
+};
+
 /// Reads a part mesh [m]. STEP files (LooksLikeStep) go through LoadStep, the rest through
 /// ImportMesh. Fails with kIo or kInvalidInput naming the file; `solid` on a file that is not
 /// STEP is refused.
-Result<TriangleMesh> LoadMeshFile(const std::filesystem::path& path,
-                                  const MeshFileOptions& options = {});
+Result<MeshFile> LoadMeshFile(const std::filesystem::path& path,
+                              const MeshFileOptions& options = {});
 
 }  // namespace wrap

@@ -358,7 +358,8 @@ class StepReader {
     std::vector<TopoDS_Shape> bodies;
     for (TopExp_Explorer e(shape, TopAbs_SOLID); e.More(); e.Next()) bodies.push_back(e.Current());
     // A surface model: its shells (those not inside a solid) count as solids when they mesh
-    // closed; open ones are skipped with a warning (a solid that does not mesh closed fails).
+    // closed. An OPEN_SHELL that does not is skipped with a warning; a CLOSED_SHELL (what
+    // OpenCASCADE leaves of a damaged MANIFOLD_SOLID_BREP) that does not fails like a solid.
     const size_t first_shell = bodies.size();
     for (TopExp_Explorer e(shape, TopAbs_SHELL, TopAbs_SOLID); e.More(); e.Next()) {
       bodies.push_back(e.Current());
@@ -390,7 +391,7 @@ class StepReader {
       solid.name = UniqueSolidName(name);
       solid.entity = Entity(bodies[k], "");
       auto mesh = MeshOf(bodies[k], solid);
-      if (!mesh && k >= first_shell) {
+      if (!mesh && k >= first_shell && solid.entity.find("OPEN_SHELL") != std::string::npos) {
         solid_names_.erase(solid.name);
         out_.warnings.push_back("shell " + Quote(solid.name) +
                                 (solid.entity.empty() ? "" : " (" + solid.entity + ")") +

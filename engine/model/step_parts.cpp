@@ -6,6 +6,7 @@
 
 #include "geometry/convex_hull.h"
 #include "geometry/stable_placement.h"
+#include "model/validate.h"
 
 namespace wrap {
 
@@ -54,9 +55,17 @@ std::vector<Part> PartsFromStep(const StepAssembly& assembly, const Project& pro
   std::set<std::string> taken;
   for (const Part& p : project.parts) taken.insert(p.name);
   for (const Step& s : project.steps) taken.insert(s.name);
-  // Spots already used on the table: the parts there, as discs of 10 cm around their origins.
-  std::vector<Eigen::Vector2d> occupied;
-  for (const Part& p : project.parts) occupied.push_back(p.initial_pose.xyz.head<2>());
+  // Spots already used on the table: the parts there (discs of 5 cm around their origins) and
+  // the robots' bases (15 cm).
+  struct Disc {
+    Eigen::Vector2d centre;
+    double radius = 0.0;
+  };
+  std::vector<Disc> occupied;
+  for (const Part& p : project.parts) occupied.push_back({p.initial_pose.xyz.head<2>(), 0.05});
+  for (const Robot& r : project.robots) {
+    occupied.push_back({RobotBaseInWorld(project, r).translation().head<2>(), 0.15});
+  }
 
   const Table& table = project.table;
   const Eigen::Vector2d corner =
@@ -84,7 +93,7 @@ std::vector<Part> PartsFromStep(const StepAssembly& assembly, const Project& pro
     part.assembled_pose = FromIsometry(inst.X_AS);
     part.color = inst.color ? Rgba(*inst.color) : NewPartColor(project.parts.size() + parts.size());
 
-    // The next free spot of the rows, clear of the parts already on the table.
+    // The next free spot of the rows, clear of the parts and robots already on the table.
     const auto [lo, hi] = Footprint(mesh, rest[s]);
     const Eigen::Vector2d size = hi - lo;
     for (int tries = 0; tries < 1000; ++tries) {
@@ -94,16 +103,16 @@ std::vector<Part> PartsFromStep(const StepAssembly& assembly, const Project& pro
         row_depth = 0.0;
       }
       const Eigen::Vector2d centre(x + 0.5 * size.x(), y + 0.5 * size.y());
-      const double reach = 0.5 * size.norm() + 0.1;
-      const bool clear = std::none_of(occupied.begin(), occupied.end(),
-                                      [&](const auto& o) { return (o - centre).norm() < reach; });
+      const bool clear = std::none_of(occupied.begin(), occupied.end(), [&](const Disc& o) {
+        return (o.centre - centre).norm() < 0.5 * size.norm() + o.radius + kGap_m;
+      });
       if (clear) break;
       x += 0.5 * size.x() + kGap_m;
     }
     Iso3 X_WP = rest[s];
     X_WP.translation() += Vec3(x - lo.x(), y - lo.y(), table.height);
     part.initial_pose = FromIsometry(X_WP);
-    occupied.push_back(Eigen::Vector2d(x + 0.5 * size.x(), y + 0.5 * size.y()));
+    occupied.push_back({Eigen::Vector2d(x + 0.5 * size.x(), y + 0.5 * size.y()), 0.0});
     x += size.x() + kGap_m;
     row_depth = std::max(row_depth, size.y());
     parts.push_back(std::move(part));

@@ -25,7 +25,7 @@ struct StepPartsOptions {
 /// `solid` = the instance's solid (so instances of one product share one mesh), assembled pose =
 /// the instance's placement in the file, colour = the file's (else one from a palette), initial
 /// pose = resting on `project`'s table in the part's most stable placement, side by side in rows
-/// from the table's -x/-y corner, clear of the parts already there.
+/// from the table's -x/-y corner, clear of the parts already there and of the robots' bases.
 std::vector<Part> PartsFromStep(const StepAssembly& assembly, const Project& project,
                                 const StepPartsOptions& options);
 

@@ -223,7 +223,10 @@ class Checker {
       Error(path + ".mesh", "cannot read mesh " + Quote(part.mesh) + ": " + mesh.error().message);
       return;
     }
-    geo.mesh = std::move(*mesh);
+    for (const std::string& w : mesh->warnings) {
+      Warning(path + ".mesh", Quote(part.mesh) + ": " + w);
+    }
+    geo.mesh = std::move(mesh->mesh);
     geo.topology = AnalyzeTopology(geo.mesh);
     geo.aabb = ComputeAabb(geo.mesh);
     const Vec3 size = geo.aabb.size();

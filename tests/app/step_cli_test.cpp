@@ -54,6 +54,7 @@ TEST_F(StepCli, ValidateInfoAndPlan) {
   r = Wrap({"info", File()});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("leg_4"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("stool.step [leg]"), std::string::npos) << r.out;
   const fs::path plan = dir_ / "plan.json";
   r = Wrap({"plan", File(), "-o", plan.string(), "--validate", "--task-only"});
   ASSERT_EQ(r.code, 0) << r.out << r.err;

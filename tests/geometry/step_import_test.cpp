@@ -359,10 +359,8 @@ TEST_F(StepImportTest, TruncatedFile) {
   // Cut in the middle but with the end marker put back: the parser names the line.
   const fs::path spliced =
       WriteText("spliced.step", text.substr(0, text.size() / 2) + "\nENDSEC;\nEND-ISO-10303-21;\n");
-  auto a = ImportStep(spliced);
-  ASSERT_FALSE(a.has_value());
-  EXPECT_EQ(a.error().code, ErrorCode::kInvalidInput);
-  EXPECT_NE(a.error().message.find(spliced.string()), std::string::npos) << a.error().message;
+  ExpectError(ImportStep(spliced), ErrorCode::kInvalidInput, spliced,
+              {"Line ", "near entity #", "syntax"});
 }
 
 TEST_F(StepImportTest, FileWithoutSolids) {
@@ -389,7 +387,39 @@ TEST_F(StepImportTest, SolidThatDoesNotMeshClosed) {
   ASSERT_TRUE(std::regex_search(text, m, shell));
   text.replace(static_cast<size_t>(m.position(1)), m.length(1) + 1, "");
   const fs::path open = WriteText("open.step", text);
-  ExpectError(ImportStep(open), ErrorCode::kInvalidInput, open, {"'box'", "#", "closed"});
+  ExpectError(ImportStep(open), ErrorCode::kInvalidInput, open,
+              {"solid 'box'", "CLOSED_SHELL", "does not mesh closed"});
+}
+
+TEST_F(StepImportTest, OpenSurfaceModelIsSkippedWithAWarning) {
+  SKIP_WITHOUT_OCCT();
+  std::string text = Text(WriteSpec(PegAndHole().Spec("MM"), "peg_and_hole.step"));
+  // The plate (the first solid) as a surface model of an open shell: one face dropped.
+  const std::regex brep(R"((#\d+) = ADVANCED_BREP_SHAPE_REPRESENTATION)");
+  const std::regex solid(R"((#\d+) = MANIFOLD_SOLID_BREP\('',(#\d+)\);)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(text, m, brep));
+  text.replace(static_cast<size_t>(m.position(0)), m.length(0),
+               m.str(1) + " = MANIFOLD_SURFACE_SHAPE_REPRESENTATION");
+  ASSERT_TRUE(std::regex_search(text, m, solid));
+  const std::string shell = m.str(2);
+  text.replace(static_cast<size_t>(m.position(0)), m.length(0),
+               m.str(1) + " = SHELL_BASED_SURFACE_MODEL(''," + "(" + shell + "));");
+  const std::regex closed(shell + R"( = CLOSED_SHELL\(\s*'[^']*'\s*,\s*\(\s*(#\d+)\s*,)");
+  ASSERT_TRUE(std::regex_search(text, m, closed));
+  text.replace(static_cast<size_t>(m.position(1)), m.length(1) + 1, "");
+  const std::string closed_shell = shell + " = CLOSED_SHELL(";
+  const size_t at = text.find(closed_shell);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, closed_shell.size(), shell + " = OPEN_SHELL(");
+  const fs::path file = WriteText("surface.step", text);
+  auto a = ImportStep(file);
+  ASSERT_TRUE(a.has_value()) << a.error().message;
+  ASSERT_EQ(a->instances.size(), 4u) << "the four legs; the plate is skipped";
+  EXPECT_EQ(a->instances[0].name, "leg_1");
+  ASSERT_EQ(a->warnings.size(), 1u);
+  EXPECT_NE(a->warnings[0].find("'plate'"), std::string::npos) << a->warnings[0];
+  EXPECT_NE(a->warnings[0].find("OPEN_SHELL"), std::string::npos) << a->warnings[0];
 }
 
 TEST_F(StepImportTest, FileWithoutLengthUnit) {
@@ -510,14 +540,15 @@ TEST_F(StepImportTest, LoadMeshFilePicksASolidOrTheWholeFile) {
   const fs::path file = WriteSpec(d.Spec("MM"), "peg_and_hole.step");
   auto leg = LoadMeshFile(file, {.solid = "leg"});
   ASSERT_TRUE(leg.has_value()) << leg.error().message;
-  EXPECT_NEAR(Volume(*leg), d.LegVolume(), kVolumeRel * d.LegVolume());
+  EXPECT_NEAR(Volume(leg->mesh), d.LegVolume(), kVolumeRel * d.LegVolume());
   auto by_instance = LoadMeshFile(file, {.solid = "leg_3"});  // an instance: its solid
   ASSERT_TRUE(by_instance.has_value());
-  EXPECT_EQ(by_instance->vertices, leg->vertices);
+  EXPECT_EQ(by_instance->mesh.vertices, leg->mesh.vertices);
   auto whole = LoadMeshFile(file, {.scale = 2.0});
   ASSERT_TRUE(whole.has_value());
   const double total = 8.0 * (d.PlateVolume() + 4 * d.LegVolume());
-  EXPECT_NEAR(Volume(*whole), total, kVolumeRel * total);
+  EXPECT_NEAR(Volume(whole->mesh), total, kVolumeRel * total);
+  EXPECT_TRUE(whole->warnings.empty());
   auto missing = LoadMeshFile(file, {.solid = "seat"});
   ASSERT_FALSE(missing.has_value());
   EXPECT_NE(missing.error().message.find("no solid or part 'seat'"), std::string::npos);

@@ -205,6 +205,11 @@ TEST_F(StepProjectTest, PartsFromStepRestOnTheTableWithFileNamesPosesAndColours)
     EXPECT_NEAR(box.min.z(), p.table.height, 1e-6) << p.parts[i].name;
     EXPECT_GE(box.min.x(), -p.table.size.x() / 2) << p.parts[i].name;
     EXPECT_LE(box.max.y(), p.table.size.y() / 2) << p.parts[i].name;
+    for (const Robot& r : p.robots) {  // clear of the robots' bases
+      const Vec3 base = RobotBaseInWorld(p, r).translation();
+      const Vec3 nearest = base.cwiseMax(box.min).cwiseMin(box.max);
+      EXPECT_GT((nearest - base).head<2>().norm(), 0.1) << p.parts[i].name << " on " << r.name;
+    }
     for (const Aabb& other : boxes) {
       const bool apart = (box.min.head<2>().array() >= other.max.head<2>().array()).any() ||
                          (other.min.head<2>().array() >= box.max.head<2>().array()).any();
