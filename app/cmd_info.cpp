@@ -131,7 +131,8 @@ int Info(const std::string& project, std::ostream& out, std::ostream& err) {
     char size[64];
     std::snprintf(size, sizeof size, "%.1f x %.1f x %.1f", s.x(), s.y(), s.z());
     out << "  " << Pad(p.parts[i].name, 18) << Pad(Fmt("%.4f", g.mass_kg), 11) << Pad(size, 26)
-        << Pad(std::to_string(g.mesh.triangles.size()), 11) << p.parts[i].mesh << "\n";
+        << Pad(std::to_string(g.mesh.triangles.size()), 11) << p.parts[i].mesh
+        << (p.parts[i].solid.empty() ? "" : " [" + p.parts[i].solid + "]") << "\n";
     total += g.mass_kg;
   }
   out << "  total mass " << Fmt("%.4f", total) << " kg\n";

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes the loaders with libFuzzer (clang-14, AddressSanitizer + UndefinedBehaviorSanitizer):
 #   scripts/fuzz.sh [SECONDS] [TARGET...]
-# TARGET: project_json mesh_stl mesh_obj mesh_ply urdf (default: all), SECONDS per target
+# TARGET: project_json mesh_stl mesh_obj mesh_ply step urdf (default: all), SECONDS per target
 # (default 60). FUZZ_BUILD_DIR (default build-fuzz) may be set.
 #
 # Installs the project's packages plus clang-14 and libclang-rt-14-dev when missing, configures
@@ -17,7 +17,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[[ ${#targets[@]} -gt 0 ]] || targets=(project_json mesh_stl mesh_obj mesh_ply urdf)
+[[ ${#targets[@]} -gt 0 ]] || targets=(project_json mesh_stl mesh_obj mesh_ply step urdf)
 BUILD=${FUZZ_BUILD_DIR:-build-fuzz}
 
 bash scripts/install_deps.sh
@@ -46,6 +46,7 @@ extra_dirs() {
     project_json) echo projects ;;
     mesh_stl) echo assets/parts/stool ;;
     mesh_obj) echo assets/parts/chair assets/parts/cross assets/parts/cube ;;
+    step) echo assets/parts/step ;;
     *) ;;
   esac
 }

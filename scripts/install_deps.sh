@@ -13,6 +13,9 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   # engine: math, mesh import, project files, command line
   libeigen3-dev libassimp-dev nlohmann-json3-dev libcli11-dev
+  # STEP import: OpenCASCADE 7.6 (data exchange, modelling, OCAF/XCAF; WRAP_WITH_OCCT)
+  libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev
+  libocct-foundation-dev libocct-ocaf-dev
   # preprocessing: convex hulls (qhull), parallel grasp sampling (oneTBB)
   libqhull-dev libtbb-dev
   # robots: collision (FCL + libccd), URDF import

@@ -1,9 +1,11 @@
 // wrap_make_parts OUT_DIR: writes the team's benchmark part meshes (stool, chair, cross, cube) to
-// OUT_DIR/<assembly>/<part>.<stl|obj>, in millimetres. The committed copy lives in assets/parts.
+// OUT_DIR/<assembly>/<part>.<stl|obj>, in millimetres, and the STEP stool assembly to
+// OUT_DIR/step/stool.step (with OpenCASCADE). The committed copy lives in assets/parts.
 #include <cstdio>
 #include <filesystem>
 
 #include "generator/part_designs.h"
+#include "generator/step_designs.h"
 
 int main(int argc, char** argv) {
   if (argc != 2) {
@@ -27,5 +29,16 @@ int main(int argc, char** argv) {
     std::printf("%s: %zu triangles\n", (out_dir / part.RelativePath()).string().c_str(),
                 part.mesh.triangles.size());
   }
+  const std::filesystem::path step = out_dir / wrap::partgen::kStepStoolFile;
+  if (!wrap::StepImportAvailable()) {
+    std::printf("%s: skipped (built without OpenCASCADE)\n", step.string().c_str());
+    return 0;
+  }
+  std::filesystem::create_directories(step.parent_path());
+  if (auto ok = wrap::WriteStep(wrap::partgen::StepStoolSpec(), step); !ok) {
+    std::fprintf(stderr, "wrap_make_parts: %s\n", ok.error().message.c_str());
+    return 2;
+  }
+  std::printf("%s: STEP assembly\n", step.string().c_str());
   return 0;
 }

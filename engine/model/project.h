@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/pose.h"
+#include "geometry/step_import.h"
 
 namespace wrap {
 
@@ -28,8 +29,12 @@ struct WrenchBox {
 struct Part {
   std::string name;                   ///< Unique among parts and steps.
   std::string mesh;                   ///< Mesh path as written (relative to the project file;
-                                      ///< may use ${NAME} from Project::paths).
-  double scale = 1.0;                 ///< Mesh units to metres (0.001 for mm, 0.01 for cm).
+                                      ///< may use ${NAME} from Project::paths); STL, OBJ, ...
+                                      ///< or STEP (.step, .stp).
+  std::string solid;                  ///< STEP only: the solid or part of the file to use, in
+                                      ///< its own frame; empty: the whole file as assembled.
+  double scale = 1.0;                 ///< Mesh units to metres (0.001 for mm, 0.01 for cm);
+                                      ///< STEP files come in metres (1).
   std::optional<double> mass_kg;      ///< Mass [kg]; when absent, density * mesh volume.
   double density_kg_m3 = 1240.0;      ///< Density [kg/m^3] (PLA) used when mass is absent.
   Pose assembled_pose;                ///< X_AP: part frame in the assembly frame (default
@@ -158,6 +163,7 @@ struct Project {
   Table table;                           ///< The table.
   GeometryTolerances geometry;           ///< What the geometry checks count as touching.
   PlannerDefaults planner;               ///< Planner defaults.
+  StepTessellation tessellation;         ///< How STEP meshes are tessellated.
   bool operator==(const Project&) const = default;
 };
 

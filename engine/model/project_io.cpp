@@ -230,10 +230,11 @@ class Reader {
 void ReadPart(Reader& r, const json& j, const std::string& path, Part& part) {
   if (!r.Object(j, path)) return;
   r.CheckKeys(j, path,
-              {"name", "mesh", "scale", "mass_kg", "density_kg_m3", "assembled_pose",
+              {"name", "mesh", "solid", "scale", "mass_kg", "density_kg_m3", "assembled_pose",
                "initial_pose", "color"});
   r.String(j, path, "name", part.name, true);
   r.String(j, path, "mesh", part.mesh, true);
+  r.String(j, path, "solid", part.solid);
   r.Number(j, path, "scale", part.scale);
   if (j.contains("mass_kg")) {
     double m = 0.0;
@@ -352,6 +353,15 @@ void ReadGeometry(Reader& r, const json& j, const std::string& path, GeometryTol
   r.Number(j, path, "touch_depth_m", g.touch_depth_m);
 }
 
+void ReadTessellation(Reader& r, const json& j, const std::string& path, StepTessellation& t) {
+  if (!r.Object(j, path)) return;
+  r.CheckKeys(j, path, {"linear_deflection_m", "angular_deflection_deg"});
+  r.Number(j, path, "linear_deflection_m", t.linear_deflection_m);
+  double degrees = t.angular_deflection_rad * 180.0 / std::numbers::pi;
+  r.Number(j, path, "angular_deflection_deg", degrees);
+  t.angular_deflection_rad = degrees * std::numbers::pi / 180.0;
+}
+
 void ReadPlanner(Reader& r, const json& j, const std::string& path, PlannerDefaults& p) {
   if (!r.Object(j, path)) return;
   r.CheckKeys(j, path, {"grasps", "widen_grasps", "time_limit_s", "seed"});
@@ -468,7 +478,7 @@ ProjectParse ParseProject(std::string_view json_text, const std::string& file_la
   r.CheckKeys(root, "",
               {"format", "version", "name", "description", "paths", "table", "parts", "steps",
                "connection_limits", "wrench_limits", "mobile_bases", "robots", "geometry",
-               "planner"});
+               "planner", "tessellation"});
   Project p;
   // Every error above inside a field is recorded and parsing goes on; the project is returned
   // so that validation can report the rest.
@@ -492,6 +502,9 @@ ProjectParse ParseProject(std::string_view json_text, const std::string& file_la
     }
     if (const json* j = r.Member(root, "", "planner", false)) {
       ReadPlanner(r, *j, "planner", p.planner);
+    }
+    if (const json* j = r.Member(root, "", "tessellation", false)) {
+      ReadTessellation(r, *j, "tessellation", p.tessellation);
     }
   } catch (const std::exception& e) {
     // A json accessor can still throw on a shape we did not anticipate: report, do not crash.
@@ -534,7 +547,9 @@ std::string SerializeProject(const Project& p) {
                         {"friction", p.table.friction}};
   ojson parts = ojson::array();
   for (const Part& part : p.parts) {
-    ojson j{{"name", part.name}, {"mesh", part.mesh}, {"scale", part.scale}};
+    ojson j{{"name", part.name}, {"mesh", part.mesh}};
+    if (!part.solid.empty()) j["solid"] = part.solid;
+    j["scale"] = part.scale;
     if (part.mass_kg) j["mass_kg"] = *part.mass_kg;
     j["density_kg_m3"] = part.density_kg_m3;
     j["assembled_pose"] = PoseJson(part.assembled_pose);
@@ -600,6 +615,11 @@ std::string SerializeProject(const Project& p) {
                           {"widen_grasps", p.planner.widen_grasps},
                           {"time_limit_s", p.planner.time_limit_s},
                           {"seed", p.planner.seed}};
+  if (p.tessellation != StepTessellation{}) {
+    root["tessellation"] = ojson{{"linear_deflection_m", p.tessellation.linear_deflection_m},
+                                 {"angular_deflection_deg", p.tessellation.angular_deflection_rad *
+                                                                180.0 / std::numbers::pi}};
+  }
   // Keys keep the order written here (ordered_json): format and version first.
   return root.dump(2) + "\n";
 }

@@ -2,9 +2,11 @@
 
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <sstream>
 
-#include "geometry/mesh_import.h"
+#include "geometry/mesh_file.h"
+#include "geometry/step_cache.h"
 #include "model/catalog.h"
 #include "model/paths.h"
 #include "model/project_io.h"
@@ -80,6 +82,7 @@ class Checker {
     CheckTable();
     Positive(p_.geometry.contact_m, "geometry.contact_m");
     NonNegative(p_.geometry.touch_depth_m, "geometry.touch_depth_m");
+    CheckTessellation();
     CheckNames();
     out_.parts.assign(p_.parts.size(), PartGeometry{});
     if (p_.parts.empty()) Error("parts", "the project needs at least one part");
@@ -97,6 +100,21 @@ class Checker {
   }
 
  private:
+  void CheckTessellation() {
+    const StepTessellation& t = p_.tessellation;
+    if (!(t.linear_deflection_m >= 1e-7 && t.linear_deflection_m <= 0.1)) {
+      Error("tessellation.linear_deflection_m",
+            "must be between 1e-7 and 0.1 m, found " + Num(t.linear_deflection_m));
+      tessellation_ok_ = false;
+    }
+    const double degrees = t.angular_deflection_rad * 180.0 / std::numbers::pi;
+    if (!(t.angular_deflection_rad >= 1e-3 && t.angular_deflection_rad <= std::numbers::pi / 2)) {
+      Error("tessellation.angular_deflection_deg",
+            "must be between 0.06 and 90 degrees, found " + Num(degrees));
+      tessellation_ok_ = false;
+    }
+  }
+
   void CheckTable() {
     PositiveVec(p_.table.size, "table.size");
     Finite(p_.table.center_xy.x(), "table.center_xy[0]");
@@ -185,15 +203,32 @@ class Checker {
       Error(path + ".mesh", msg);
       return;
     }
+    const bool step = LooksLikeStep(resolved->path);
+    if (!part.solid.empty() && !step) {
+      Error(path + ".solid", "names a solid of a STEP file, but " + Quote(part.mesh) +
+                                 " is not one; remove 'solid' or use a .step/.stp mesh");
+      return;
+    }
+    if (step && std::isfinite(part.scale) && part.scale != 1.0) {
+      Warning(path + ".scale", "STEP files come in metres from their own unit; scale " +
+                                   Num(part.scale) + " resizes the part (1 keeps it as designed)");
+    }
     if (!options.load_meshes || !(part.scale > 0.0) || !std::isfinite(part.scale)) return;
-    MeshImportOptions mo;
+    if (step && !tessellation_ok_) return;  // reported at "tessellation"
+    MeshFileOptions mo;
     mo.scale = part.scale;
-    auto mesh = ImportMesh(resolved->path, mo);
+    mo.solid = part.solid;
+    mo.tessellation = p_.tessellation;
+    if (!file_path_.empty()) mo.cache_dir = StepCacheDirFor(file_path_);
+    auto mesh = LoadMeshFile(resolved->path, mo);
     if (!mesh) {
       Error(path + ".mesh", "cannot read mesh " + Quote(part.mesh) + ": " + mesh.error().message);
       return;
     }
-    geo.mesh = std::move(*mesh);
+    for (const std::string& w : mesh->warnings) {
+      Warning(path + ".mesh", Quote(part.mesh) + ": " + w);
+    }
+    geo.mesh = std::move(mesh->mesh);
     geo.topology = AnalyzeTopology(geo.mesh);
     geo.aabb = ComputeAabb(geo.mesh);
     const Vec3 size = geo.aabb.size();
@@ -410,6 +445,7 @@ class Checker {
   const fs::path& file_path_;
   const std::string file_;
   ProjectCheck& out_;
+  bool tessellation_ok_ = true;  // STEP meshes are read only with valid deflections
 };
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <tuple>
 
 #include "robot/home.h"
 #include "robot/project_chain.h"
@@ -155,8 +156,10 @@ Result<CellScene> BuildCellScene(const Project& project, const ProjectCheck& che
     scene.robots.push_back(std::move(robot));
   }
 
-  // Parts made from the same file at the same scale share one mesh.
-  std::map<std::pair<std::string, double>, std::shared_ptr<const TriangleMesh>> meshes;
+  // Parts made from the same file (and the same solid of a STEP file) at the same scale share
+  // one mesh.
+  std::map<std::tuple<std::string, std::string, double>, std::shared_ptr<const TriangleMesh>>
+      meshes;
   for (size_t i = 0; i < project.parts.size(); ++i) {
     const Part& p = project.parts[i];
     if (i >= check.parts.size() || !check.parts[i].loaded) {
@@ -164,7 +167,7 @@ Result<CellScene> BuildCellScene(const Project& project, const ProjectCheck& che
                                                 "' is not loaded (run 'wrap validate')");
     }
     const PartGeometry& geometry = check.parts[i];
-    auto& shared = meshes[{geometry.resolved.string(), p.scale}];
+    auto& shared = meshes[{geometry.resolved.string(), p.solid, p.scale}];
     if (!shared) shared = std::make_shared<const TriangleMesh>(geometry.mesh);
     scene.parts.push_back(
         {p.name, shared, p.color, ToIsometry(p.initial_pose), ToIsometry(p.assembled_pose)});

@@ -12,6 +12,7 @@
 
 #include "geometry/mesh.h"
 #include "geometry/mesh_import.h"
+#include "geometry/step_import.h"
 #include "model/project_io.h"
 #include "model/validate.h"
 #include "robot/urdf_import.h"
@@ -105,6 +106,41 @@ int FuzzMesh(const uint8_t* data, size_t size, const std::string& extension) {
     (void)ComputeMassProperties(*mesh);
   } catch (const std::exception& e) {
     Broken("mesh", std::string("exception escaped: ") + e.what());
+  }
+  return 0;
+}
+
+int FuzzStep(const uint8_t* data, size_t size) {
+  const fs::path file = WriteScratch("model.step", data, size);
+  try {
+    auto assembly = ImportStep(file, {.linear_deflection_m = 1e-3, .angular_deflection_rad = 0.5});
+    if (!assembly) {
+      if (assembly.error().message.empty()) Broken("step", "failure without a message");
+      return 0;
+    }
+    if (!StepImportAvailable()) Broken("step", "accepted a file without OpenCASCADE");
+    if (assembly->instances.empty()) Broken("step", "accepted a file without instances");
+    for (const StepInstance& inst : assembly->instances) {
+      if (inst.solid < 0 || inst.solid >= static_cast<int>(assembly->solids.size())) {
+        Broken("step", "instance '" + inst.name + "' names no solid");
+      }
+      if (!inst.X_AS.matrix().allFinite()) Broken("step", "non-finite placement");
+    }
+    for (const StepSolid& solid : assembly->solids) {
+      const int n = static_cast<int>(solid.mesh.vertices.size());
+      for (const auto& t : solid.mesh.triangles) {
+        if (t.minCoeff() < 0 || t.maxCoeff() >= n) Broken("step", "triangle index out of range");
+      }
+      if (!AnalyzeTopology(solid.mesh).closed()) Broken("step", "open solid '" + solid.name + "'");
+      if (!(ComputeMassProperties(solid.mesh).volume_m3 > 0.0)) {
+        Broken("step", "solid '" + solid.name + "' is not outward");
+      }
+      auto picked = FindStepSolid(*assembly, solid.name, file.string());
+      if (!picked) Broken("step", "solid '" + solid.name + "' cannot be picked by its name");
+    }
+    (void)ComputeMassProperties(MergedInstances(*assembly));
+  } catch (const std::exception& e) {
+    Broken("step", std::string("exception escaped: ") + e.what());
   }
   return 0;
 }

@@ -102,6 +102,12 @@ TEST(FuzzReplay, MeshPly) {
             2);
 }
 
+TEST(FuzzReplay, Step) {
+  std::vector<fs::path> files = Corpus("step");
+  Append(files, FilesWithExtension(kRepo / "assets/parts", ".step"));
+  EXPECT_GE(Replay(files, wrap::fuzz::FuzzStep), 3);
+}
+
 TEST(FuzzReplay, Urdf) { EXPECT_GE(Replay(Corpus("urdf"), wrap::fuzz::FuzzUrdf), 2); }
 
 // The target bodies must be able to fail: a valid project whose serialisation does not parse back

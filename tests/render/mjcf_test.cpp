@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <numbers>
 
+#include "geometry/step_import.h"
 #include "robot/home.h"
 #include "robot/kinematics.h"
 #include "sim/mjcf.h"
@@ -62,6 +63,18 @@ TEST(CellScene, StoolHasRobotsPartsAndSteps) {
     EXPECT_TRUE(WithinLimits(r.chain, r.home)) << r.name;
     EXPECT_EQ(r.pedestal_radius_m, 0.0) << r.name << " stands on the table";
   }
+}
+
+// Parts from one STEP file share a mesh only when they use the same solid of it.
+TEST(CellScene, StepPartsShareMeshesBySolid) {
+  if (!StepImportAvailable()) GTEST_SKIP() << "built without OpenCASCADE (WRAP_WITH_OCCT=OFF)";
+  const Loaded l = Load("stool_step");
+  const CellScene& s = l.scene;
+  ASSERT_EQ(s.parts.size(), 5u);
+  EXPECT_EQ(s.parts[1].mesh.get(), s.parts[4].mesh.get()) << "the legs: one solid";
+  EXPECT_NE(s.parts[0].mesh.get(), s.parts[1].mesh.get()) << "the seat is another solid";
+  EXPECT_NEAR(ComputeAabb(*s.parts[1].mesh).size().z(), 0.199, 1e-6);
+  EXPECT_NEAR(ComputeAabb(*s.parts[0].mesh).size().x(), 0.240, 1e-6);
 }
 
 TEST(CellScene, HomeFacesTheTableWithTheToolDown) {

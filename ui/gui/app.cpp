@@ -32,7 +32,8 @@ constexpr double kAutosavePeriodS = 30.0;
 bool IsMeshFile(const fs::path& p) {
   std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  for (const char* m : {".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".3mf", ".dae"}) {
+  for (const char* m :
+       {".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".3mf", ".dae", ".step", ".stp"}) {
     if (ext == m) return true;
   }
   return false;
@@ -98,7 +99,8 @@ void App::Frame(render::Image* capture) {
     } else if (fs::path(f).extension() == ".urdf") {
       robots_.AddUrdf(s_, f);
     } else {
-      s_.Notify("Dropped file not recognised (a mesh, a robot .urdf or a project .json): " + f);
+      s_.Notify("Dropped file not recognised (a mesh or STEP file, a robot .urdf or a project "
+                ".json): " + f);
     }
   }
   TakeRun();

@@ -5,7 +5,9 @@
 #include <numbers>
 
 #include "geometry/mesh_import.h"
+#include "geometry/step_cache.h"
 #include "model/catalog.h"
+#include "model/step_parts.h"
 #include "robot/urdf_import.h"
 
 namespace wrap::gui {
@@ -80,6 +82,25 @@ void DropInput(Step& step, const std::string& input) {
   if (step.mating.base == input) step.mating.base.clear();
 }
 
+/// `file` as a project writes it: relative to the folder of `project_file` where it can be.
+std::string ProjectRelativePath(const fs::path& project_file, const fs::path& file) {
+  const fs::path dir = fs::absolute(project_file).parent_path();
+  const fs::path absolute = fs::absolute(file).lexically_normal();
+  const fs::path relative = absolute.lexically_relative(dir);
+  return relative.empty() ? absolute.string() : relative.generic_string();
+}
+
+/// Where an imported part with bounding box `box` goes: on the table, in a row along +y beside
+/// the parts already there, its box's centre over the spot, its lowest point on the top.
+Vec3 NextInRow(const Project& project, const Aabb& box) {
+  const double spacing = std::max(0.12, 1.2 * std::max(box.size().x(), box.size().y()));
+  const double row = -0.5 * project.table.size.y() + spacing;
+  const double y = row + spacing * static_cast<double>(project.parts.size());
+  const Vec3 centre = 0.5 * (box.min + box.max);
+  return Vec3(project.table.center_xy.x() - centre.x(),
+              project.table.center_xy.y() + y - centre.y(), project.table.height - box.min.z());
+}
+
 Result<void> CheckCatalog(const Robot& robot) {
   if (robot.urdf.empty() && !FindRobotModel(robot.model)) {
     return Refuse("robot model " + Quote(robot.model) + " is not in the catalog (" +
@@ -116,6 +137,20 @@ Command AddPart(Part part) {
   return {label, "", [part](Project& p) -> Result<void> {
             if (auto ok = CheckNewName(p, part.name, ""); !ok) return ok;
             p.parts.push_back(part);
+            return {};
+          }};
+}
+
+Command AddParts(std::vector<Part> parts) {
+  const std::string label = parts.size() == 1 ? "add part " + Quote(parts.front().name)
+                                              : "add " + std::to_string(parts.size()) + " parts";
+  return {label, "", [parts](Project& p) -> Result<void> {
+            Project next = p;
+            for (const Part& part : parts) {
+              if (auto ok = CheckNewName(next, part.name, ""); !ok) return ok;
+              next.parts.push_back(part);
+            }
+            p = std::move(next);
             return {};
           }};
 }
@@ -166,27 +201,32 @@ Result<Part> PreparePartImport(const Project& project, const fs::path& project_f
   Part part;
   part.name = UniqueName(
       project, mesh_file.stem().string().empty() ? std::string("part") : mesh_file.stem().string());
-  const fs::path dir = fs::absolute(project_file).parent_path();
-  const fs::path absolute = fs::absolute(mesh_file).lexically_normal();
-  const fs::path relative = absolute.lexically_relative(dir);
-  part.mesh = relative.empty() ? absolute.string() : relative.generic_string();
+  part.mesh = ProjectRelativePath(project_file, mesh_file);
   part.scale = options.scale;
   part.mass_kg = options.mass_kg;
   part.density_kg_m3 = options.density_kg_m3;
-  static const Rgba kPalette[] = {{0.949, 0.557, 0.169, 1}, {0.306, 0.475, 0.655, 1},
-                                  {0.463, 0.718, 0.698, 1}, {0.349, 0.631, 0.310, 1},
-                                  {0.690, 0.478, 0.631, 1}, {0.882, 0.341, 0.349, 1}};
-  part.color = options.color.value_or(kPalette[project.parts.size() % std::size(kPalette)]);
-  // On the table, in a row along +y beside the parts already there: its box's centre over the
-  // spot, its lowest point on the top.
-  const double spacing = std::max(0.12, 1.2 * std::max(box.size().x(), box.size().y()));
-  const double row = -0.5 * project.table.size.y() + spacing;
-  const double y = row + spacing * static_cast<double>(project.parts.size());
-  const Vec3 centre = 0.5 * (box.min + box.max);
-  part.initial_pose.xyz =
-      Vec3(project.table.center_xy.x() - centre.x(), project.table.center_xy.y() + y - centre.y(),
-           project.table.height - box.min.z());
+  part.color = options.color.value_or(NewPartColor(project.parts.size()));
+  part.initial_pose.xyz = NextInRow(project, box);
   return part;
+}
+
+Result<std::vector<Part>> PrepareStepImport(const Project& project, const fs::path& project_file,
+                                            const fs::path& step_file) {
+  auto load = LoadStep(step_file, {.tessellation = project.tessellation,
+                                   .cache_dir = StepCacheDirFor(fs::absolute(project_file))});
+  if (!load) return std::unexpected(load.error());
+  const StepAssembly& assembly = *load->assembly;
+  const std::string mesh = ProjectRelativePath(project_file, step_file);
+  if (assembly.instances.size() > 1) return PartsFromStep(assembly, project, {.mesh = mesh});
+  // One solid: a part like an imported mesh, but with the file's name and colour.
+  Part part;
+  part.name = UniqueName(
+      project, step_file.stem().string().empty() ? std::string("part") : step_file.stem().string());
+  part.mesh = mesh;
+  part.color = assembly.instances.front().color ? Rgba(*assembly.instances.front().color)
+                                                : NewPartColor(project.parts.size());
+  part.initial_pose.xyz = NextInRow(project, ComputeAabb(MergedInstances(assembly)));
+  return std::vector<Part>{part};
 }
 
 // ---- Steps ----------------------------------------------------------------------------------

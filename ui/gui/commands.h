@@ -19,6 +19,8 @@ namespace wrap::gui {
 
 /// Adds `part` (its name must be new among parts and steps).
 Command AddPart(Part part);
+/// Adds `parts` as one edit (one undo step); refused, adding none, when a name is taken.
+Command AddParts(std::vector<Part> parts);
 /// Removes the part; refused while it is an input of a step (the message names the step).
 Command RemovePart(const std::string& name);
 /// Replaces the part `name` by `part`; a new name is carried into every step that refers to it.
@@ -48,6 +50,16 @@ struct PartImportOptions {
 Result<Part> PreparePartImport(const Project& project, const std::filesystem::path& project_file,
                                const std::filesystem::path& mesh_file,
                                const PartImportOptions& options);
+
+/// Parts for the STEP file `step_file`, ready for AddParts: one part for a file with one solid
+/// (the whole file, named after it, placed like PreparePartImport places a mesh), one per
+/// instance for an assembly (PartsFromStep: names, colours, assembled poses and shared meshes
+/// from the file, resting on the table). The path is written relative to the folder of
+/// `project_file`; the file is read through the tessellation cache beside the project. Fails
+/// with kIo or kInvalidInput naming the file.
+Result<std::vector<Part>> PrepareStepImport(const Project& project,
+                                            const std::filesystem::path& project_file,
+                                            const std::filesystem::path& step_file);
 
 // ---- Assembly steps (the DAG) -----------------------------------------------------------------
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "geometry/step_import.h"
 #include "gui/commands.h"
 #include "gui/fields.h"
 #include "gui/panels.h"
@@ -104,6 +105,21 @@ void FileBrowser::Draw(const char* id, const std::vector<std::string>& extension
 }
 
 void PartsPanel::Import(AppState& app, const std::string& path) {
+  if (LooksLikeStep(path)) {  // a part or a whole assembly, in the file's own unit
+    auto parts = PrepareStepImport(app.doc.project(), app.doc.ResolvePath(), path);
+    if (!parts) {
+      app.Notify("Import failed: " + parts.error().message);
+      return;
+    }
+    const std::string first = parts->front().name;
+    const size_t count = parts->size();
+    if (app.Do(AddParts(std::move(*parts)))) {
+      app.selection.part = first;
+      app.Notify(count == 1 ? "Imported '" + first + "' from " + path
+                            : "Imported " + std::to_string(count) + " parts from " + path);
+    }
+    return;
+  }
   PartImportOptions options;
   options.scale =
       MeshUnits()[std::clamp(import_unit, 0, static_cast<int>(MeshUnits().size()) - 1)].scale;
@@ -155,9 +171,10 @@ void PartsPanel::Draw(AppState& app, const PanelRect& r) {
     ImGui::SameLine();
     if (ImGui::Button("Import") && !import_path.empty()) Import(app, import_path);
     ImGui::SameLine();
-    browser.Draw("meshes", {".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".3mf", ".dae"},
+    browser.Draw("meshes",
+                 {".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".3mf", ".dae", ".step", ".stp"},
                  app.doc.ResolvePath().parent_path().string(), import_path);
-    ImGui::TextDisabled("or drop mesh files onto the window");
+    ImGui::TextDisabled("or drop mesh or STEP files onto the window (STEP: in its own unit)");
   }
 
   if (ImGui::CollapsingHeader("Parts", ImGuiTreeNodeFlags_DefaultOpen)) {

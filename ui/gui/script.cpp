@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "geometry/step_import.h"
 #include "gui/commands.h"
 #include "gui/fields.h"
 #include "gui/panels.h"
@@ -379,6 +380,12 @@ Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const 
     else
       return LineError(line, "select part|step|robot NAME");
     return effect;
+  }
+  if (cmd == "import" && LooksLikeStep(resolve(w[1]))) {  // a STEP part or assembly: one edit
+    auto parts = PrepareStepImport(app.doc.project(), app.doc.ResolvePath(), resolve(w[1]));
+    if (!parts) return LineError(line, parts.error().message);
+    app.selection.part = parts->front().name;
+    return run(AddParts(std::move(*parts)));
   }
   if (cmd == "import") {
     PartImportOptions options;

@@ -2,7 +2,9 @@
 // per line, run one per frame against the same AppState the panels edit, so that GUI flows are
 // tested in CI. '#' starts a comment. Commands:
 //   select part|step|robot NAME        set the shared selection
-//   import MESH [m|cm|mm|inch]         import a mesh as a part (relative to the script's folder)
+//   import MESH [m|cm|mm|inch]         import a mesh as a part (relative to the script's folder);
+//                                      a STEP file imports as one part or, for an assembly, one
+//                                      part per instance (in its own unit), in one edit
 //   add-step NAME | delete-step NAME | rename OLD NEW
 //   add-edge INPUT STEP | remove-edge INPUT STEP     inputs of a step (cycles are refused)
 //   add-robot MODEL END_EFFECTOR | remove-robot NAME
