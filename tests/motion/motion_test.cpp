@@ -356,7 +356,7 @@ TEST_P(ExampleMotion, TrajectoriesPassTheIndependentChecks) {
 // and the plumber's block's bolts start their insertions clear of their holes.
 INSTANTIATE_TEST_SUITE_P(Examples, ExampleMotion,
                          ::testing::Values("stool", "half_stool", "chair", "cross", "cross_openarm",
-                                           "cube", "cube_2x2x3", "fabrica_beam", "fabrica_car",
+                                           "cube", "cube_2x2x3", "fabrica_beam",
                                            "fabrica_plumbers_block"));
 
 // Deterministic as long as no path search runs out of time (a time budget depends on the
