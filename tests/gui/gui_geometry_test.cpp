@@ -77,8 +77,8 @@ TEST(GuiGeometry, ABlockedAxisShowsFreeDirectionsAndUsingOneMakesItClean) {
   const long green_free = NearColour(*free_png, kVx0, kVy0, kVx1, kVy1, 40, 215, 75);
   const long red_blocked = NearColour(*blocked_png, kVx0, kVy0, kVx1, kVy1, 240, 40, 25);
   const long red_free = NearColour(*free_png, kVx0, kVy0, kVx1, kVy1, 240, 40, 25);
-  EXPECT_GT(green_free, 40) << "the free path's sweep is drawn green";
-  EXPECT_GT(red_blocked, red_free + 40) << "the blocked path's sweep is drawn red";
+  EXPECT_GT(green_free, 15) << "the free path's sweep is drawn green";
+  EXPECT_GT(red_blocked, red_free + 15) << "the blocked path's sweep is drawn red";
   // The contacts: yellow balls and lines.
   EXPECT_GT(NearColour(*contacts_png, kVx0, kVy0, kVx1, kVy1, 255, 205, 25), 20);
 }

@@ -68,14 +68,14 @@ void App::AssembledView(SceneState& state, std::vector<render::SceneLine>& lines
       const int b = part_index(v.project->parts[c.b].name);
       if (a < 0 || b < 0) continue;
       const Vec3 at = X_WA * c.centroid_A;
-      dots.push_back({at, 0.006, kContact});
+      dots.push_back({at, 0.008, kContact});
       if (!c.normals.empty()) {
         const Vec3 n = X_WA.linear() * c.normals.front().n_A;
-        lines.push_back({at - 0.02 * n, at + 0.02 * n, kContact, 0.0012});
+        lines.push_back({at - 0.03 * n, at + 0.03 * n, kContact, 0.002});
       }
       const Vec3 ca = X_WA * (0.5 * (boxes[a].min + boxes[a].max));
       const Vec3 cb = X_WA * (0.5 * (boxes[b].min + boxes[b].max));
-      lines.push_back({ca, cb, {1.0, 0.8, 0.1, 0.6}, 0.0008});
+      lines.push_back({ca, cb, {1.0, 0.8, 0.1, 0.6}, 0.0015});
     }
   }
   // The selected step's insertion.
@@ -115,7 +115,7 @@ void App::AssembledView(SceneState& state, std::vector<render::SceneLine>& lines
     const Rgba& colour = seg.kind == SweepSegment::Kind::kFree      ? kFree
                          : seg.kind == SweepSegment::Kind::kBlocked ? kBlocked
                                                                     : kOutline;
-    const double width = seg.kind == SweepSegment::Kind::kOutline ? 0.0008 : 0.0014;
+    const double width = seg.kind == SweepSegment::Kind::kOutline ? 0.0015 : 0.003;
     lines.push_back({X_WA * seg.from_A, X_WA * seg.to_A, colour, width});
   }
 }

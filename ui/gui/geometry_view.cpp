@@ -118,7 +118,8 @@ std::string PathVerdictText(const StepVerdict& verdict, const Step& step) {
 
 Command UseInsertionAxis(const std::string& step, const Vec3& axis) {
   Command c;
-  c.label = "use insertion axis " + FormatDirection(axis) + " for step '" + step + "'";
+  const Vec3 unit = axis.norm() > 1e-9 ? Vec3(axis.normalized()) : axis;
+  c.label = "use insertion axis " + FormatDirection(unit) + " for step '" + step + "'";
   c.apply = [step, axis](Project& p) -> Result<void> {
     for (Step& s : p.steps) {
       if (s.name != step) continue;
