@@ -51,6 +51,18 @@ void App::AssembledView(SceneState& state, std::vector<render::SceneLine>& lines
   for (size_t i = 0; i < scene.parts.size() && i < state.X_WP.size(); ++i) {
     state.X_WP[i] = X_WA * scene.parts[i].X_AP;
   }
+  if (!assembled_framed_) {
+    // Turning the view on looks at the assembly (Reset view goes back to the whole cell).
+    Aabb all;
+    all.min = Vec3::Constant(1e30);
+    all.max = -all.min;
+    for (const Aabb& b : boxes) {
+      all.min = all.min.cwiseMin(X_WA * b.min);
+      all.max = all.max.cwiseMax(X_WA * b.max);
+    }
+    if (all.min.x() <= all.max.x()) s_.viewport.FrameBounds(all);
+    assembled_framed_ = true;
+  }
   const ValidationResult v = s_.validation.result();
   auto part_index = [&](const std::string& name) {
     for (size_t i = 0; i < scene.parts.size(); ++i) {

@@ -121,6 +121,7 @@ class App {
   ProblemsPanel problems_;
   ViewportPanel viewport_panel_;
   FileDialog open_dialog_, save_as_dialog_, plan_dialog_;
+  bool assembled_framed_ = false;  // the camera framed the assembly since the view went on
   bool import_open_ = false;  // open the Import assembly dialog at the next frame
   std::string import_paths_;  // its mesh files or folder, one per line
   int import_unit_ = 0;       // auto, mm, cm, m

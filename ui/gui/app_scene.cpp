@@ -62,7 +62,11 @@ void App::UpdateViewport() {
   std::vector<render::SceneLine> lines;
   std::vector<render::SceneDot> dots;
   const bool assembled = !failure && (s_.show_assembled || s_.show_contacts);
-  if (assembled) AssembledView(state, lines, dots);
+  if (assembled) {
+    AssembledView(state, lines, dots);
+  } else {
+    assembled_framed_ = false;
+  }
   (void)s_.viewport.SetState(state);
   int selected = -1;
   for (size_t i = 0; i < scene.parts.size(); ++i) {

@@ -197,6 +197,16 @@ void ViewportRenderer::ResetCamera() {
   impl_->camera.distance = view.distance_m;
 }
 
+void ViewportRenderer::FrameBounds(const Aabb& bounds) {
+  if (!ready()) return;
+  const CameraView view = FrameBox(bounds, 105.0, -35.0, 40.0, 1.4, 1.6);
+  impl_->camera.type = mjCAMERA_FREE;
+  for (int i = 0; i < 3; ++i) impl_->camera.lookat[i] = view.lookat[i];
+  impl_->camera.azimuth = view.azimuth_deg;
+  impl_->camera.elevation = view.elevation_deg;
+  impl_->camera.distance = view.distance_m;
+}
+
 CameraView ViewportRenderer::camera() const {
   CameraView view;
   if (!ready()) return view;

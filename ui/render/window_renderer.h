@@ -117,6 +117,8 @@ class ViewportRenderer {
   void Zoom(double d);
   /// Frames the whole cell from the default direction.
   void ResetCamera();
+  /// Frames `bounds` (world) tightly from the default direction (e.g. the assembled view).
+  void FrameBounds(const Aabb& bounds);
   /// The camera as it stands (azimuth, elevation [deg], distance [m], look-at point).
   CameraView camera() const;
   /// The free camera's vertical field of view [deg] (45 before any cell).
