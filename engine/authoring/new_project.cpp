@@ -132,6 +132,10 @@ Result<NewProjectResult> NewProject(const std::vector<fs::path>& meshes, const f
   if (!(options.force_N >= 0.0) || !std::isfinite(options.force_N)) {
     return Fail(ErrorCode::kInvalidInput, "--force: a finite number of newtons >= 0");
   }
+  auto tell = [&](const char* stage, double fraction) {
+    if (options.progress) options.progress(stage, fraction);
+  };
+  tell("reading the meshes", 0.0);
   auto intake = ReadAssemblyMeshes(meshes, options.unit);
   if (!intake) return std::unexpected(intake.error());
   log.push_back("unit: " + std::string(ToString(intake->unit)) + " (" + intake->unit_reason + ")");
@@ -149,6 +153,7 @@ Result<NewProjectResult> NewProject(const std::vector<fs::path>& meshes, const f
                     g.name(o.a) + "' (" + intake->files[o.a].string() +
                     "); export the parts in their assembled positions, apart or touching");
   }
+  tell("finding the contacts", 0.1);
   ContactOptions contact_options;
   contact_options.tolerance_m = tol.contact_m;
   const ContactGraph contacts = ComputeContactGraph(g, contact_options);
@@ -169,11 +174,13 @@ Result<NewProjectResult> NewProject(const std::vector<fs::path>& meshes, const f
   for (const TriangleMesh& m : intake->meshes) mesh_ptrs.push_back(&m);
   const std::vector<Iso3> X_AP(n, Iso3::Identity());
   const std::string ees[1] = {options.end_effector};
+  tell("sampling grasps", 0.2);
   RunContext ctx(0);
   auto probe = GraspProbe::Build(mesh_ptrs, X_AP, ees, GraspProbeOptions{}, ctx);
   if (!probe) return std::unexpected(probe.error());
   SequenceOptions seq_options;
   seq_options.touch_depth_m = tol.touch_depth_m;
+  tell("finding an assembly sequence", 0.35);
   const ProposedSequence seq = ProposeSequence(g, contacts, &*probe, seq_options);
   if (!seq.ok()) {
     return Fail(ErrorCode::kInfeasible,
@@ -206,6 +213,7 @@ Result<NewProjectResult> NewProject(const std::vector<fs::path>& meshes, const f
       return Fail(ErrorCode::kInternal, "wrap new: the project does not validate: " + Format(d));
     }
   }
+  tell("laying out the parts on the table", 0.6);
   auto layout = LayOutParts(p, check, output);
   if (!layout) return std::unexpected(layout.error());
   log.insert(log.end(), layout->decisions.begin(), layout->decisions.end());

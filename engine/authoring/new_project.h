@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,9 @@ struct NewProjectOptions {
   double force_N = 10.0;                      ///< Mating force of every step [N].
   std::string name;                           ///< Project name (default: the output's stem).
   int grasps = 64;                            ///< The project's grasp-set size (the paper's).
+  /// Told each stage as it starts (e.g. "reading the meshes"), with the fraction of the work
+  /// done before it; empty: nothing told. Called on the caller's thread.
+  std::function<void(const std::string& stage, double fraction)> progress;
 };
 
 /// A project made from meshes, and what was decided on the way.

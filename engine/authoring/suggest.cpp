@@ -18,19 +18,14 @@ namespace {
 
 std::string StepPath(int s) { return "steps[" + std::to_string(s) + "]"; }
 
-// A new DAG for the whole project from the geometry; false when the parts are interlocked.
-bool Reorder(const Project& project, AssemblyGeometry& g, const ContactGraph& contacts,
-             GraspProbe* probe, Project& edited, std::vector<Suggestion>& out) {
-  SequenceOptions options;
-  options.touch_depth_m = project.geometry.touch_depth_m;
-  const ProposedSequence seq = ProposeSequence(g, contacts, probe, options);
-  if (!seq.ok()) return false;
-  edited.steps.clear();
+// The steps of a proposed sequence, named after the parts of `project`.
+OrderSuggestion StepsOf(const Project& project, const ProposedSequence& seq) {
+  OrderSuggestion out;
   std::map<std::vector<int>, std::string> node;
   for (size_t i = 0; i < project.parts.size(); ++i) {
     node[{static_cast<int>(i)}] = project.parts[i].name;
   }
-  std::string order;
+  const Mating defaults = project.steps.empty() ? Mating{} : project.steps.front().mating;
   for (size_t k = 0; k < seq.steps.size(); ++k) {
     std::vector<int> moved = seq.steps[k].moved, base = seq.steps[k].base;
     std::sort(moved.begin(), moved.end());
@@ -38,7 +33,6 @@ bool Reorder(const Project& project, AssemblyGeometry& g, const ContactGraph& co
     Step step;
     step.name = "s" + std::to_string(k + 1) + "_" + node[moved];
     step.inputs = {node[base], node[moved]};
-    const Mating defaults = project.steps.empty() ? Mating{} : project.steps.front().mating;
     step.mating = defaults;
     step.mating.final_poses.clear();
     step.mating.moved = node[moved];
@@ -48,24 +42,14 @@ bool Reorder(const Project& project, AssemblyGeometry& g, const ContactGraph& co
     joined.insert(joined.end(), base.begin(), base.end());
     std::sort(joined.begin(), joined.end());
     node[joined] = step.name;
-    order += (order.empty() ? "" : "; ") + seq.steps[k].why;
-    edited.steps.push_back(std::move(step));
+    out.why.push_back(seq.steps[k].why);
+    out.steps.push_back(std::move(step));
   }
-  out.push_back({"steps", "a new order from the geometry (assembly by disassembly): " + order});
-  return true;
+  return out;
 }
 
-}  // namespace
-
-Result<SuggestResult> SuggestFixes(const Project& project, const ProjectCheck& check,
-                                   const fs::path& project_file) {
-  SuggestResult out;
-  out.edited = project;
-  if (!check.tree) {
-    return Fail(ErrorCode::kInvalidInput, "the project's assembly DAG is not well formed");
-  }
-  const GeometryReport report = CheckAssemblyGeometry(project, check, project_file.string());
-  AssemblyGeometry g = AssemblyGeometry::FromProject(project, check);
+// The grasp probe of the project's end effectors on its parts as assembled.
+Result<GraspProbe> ProbeOf(const Project& project, const AssemblyGeometry& g) {
   std::vector<const TriangleMesh*> meshes;
   std::vector<Iso3> X_AP;
   for (int p = 0; p < g.num_parts(); ++p) {
@@ -77,7 +61,65 @@ Result<SuggestResult> SuggestFixes(const Project& project, const ProjectCheck& c
     if (std::find(ees.begin(), ees.end(), r.end_effector) == ees.end()) ees.push_back(r.end_effector);
   }
   RunContext ctx(0);
-  auto probe = GraspProbe::Build(meshes, X_AP, ees, GraspProbeOptions{}, ctx);
+  return GraspProbe::Build(meshes, X_AP, ees, GraspProbeOptions{}, ctx);
+}
+
+// A new DAG for the whole project from the geometry; false when the parts are interlocked.
+bool Reorder(const Project& project, AssemblyGeometry& g, const ContactGraph& contacts,
+             GraspProbe* probe, Project& edited, std::vector<Suggestion>& out) {
+  SequenceOptions options;
+  options.touch_depth_m = project.geometry.touch_depth_m;
+  const ProposedSequence seq = ProposeSequence(g, contacts, probe, options);
+  if (!seq.ok()) return false;
+  OrderSuggestion order = StepsOf(project, seq);
+  edited.steps = std::move(order.steps);
+  std::string text;
+  for (const std::string& why : order.why) text += (text.empty() ? "" : "; ") + why;
+  out.push_back({"steps", "a new order from the geometry (assembly by disassembly): " + text});
+  return true;
+}
+
+}  // namespace
+
+Result<OrderSuggestion> SuggestOrder(const Project& project, const ProjectCheck& check) {
+  for (size_t p = 0; p < project.parts.size(); ++p) {
+    if (p >= check.parts.size() || !check.parts[p].loaded) {
+      return Fail(ErrorCode::kInvalidInput,
+                  "the mesh of part '" + project.parts[p].name + "' did not load");
+    }
+  }
+  if (project.parts.size() < 2) {
+    return Fail(ErrorCode::kInvalidInput, "an assembly order needs at least two parts");
+  }
+  AssemblyGeometry g = AssemblyGeometry::FromProject(project, check);
+  ContactOptions contact_options;
+  contact_options.tolerance_m = project.geometry.contact_m;
+  const ContactGraph contacts = ComputeContactGraph(g, contact_options);
+  auto probe = ProbeOf(project, g);
+  if (!probe) return std::unexpected(probe.error());
+  SequenceOptions options;
+  options.touch_depth_m = project.geometry.touch_depth_m;
+  const ProposedSequence seq = ProposeSequence(g, contacts, &*probe, options);
+  if (!seq.ok()) {
+    std::string names;
+    for (int p : seq.interlocked) names += (names.empty() ? "'" : ", '") + g.name(p) + "'";
+    return Fail(ErrorCode::kInfeasible,
+                "no assembly sequence: the parts " + names +
+                    " are interlocked (none of them, nor a touching pair, can leave the others)");
+  }
+  return StepsOf(project, seq);
+}
+
+Result<SuggestResult> SuggestFixes(const Project& project, const ProjectCheck& check,
+                                   const fs::path& project_file) {
+  SuggestResult out;
+  out.edited = project;
+  if (!check.tree) {
+    return Fail(ErrorCode::kInvalidInput, "the project's assembly DAG is not well formed");
+  }
+  const GeometryReport report = CheckAssemblyGeometry(project, check, project_file.string());
+  AssemblyGeometry g = AssemblyGeometry::FromProject(project, check);
+  auto probe = ProbeOf(project, g);
   if (!probe) return std::unexpected(probe.error());
 
   // The DAG: a new order where inputs do not touch or an insertion has no free axis; else a

@@ -29,6 +29,19 @@ struct SuggestResult {
 /// exists; swapping moved and base where only the base has grasps that clear the other input
 /// where mated; new initial poses for parts that overlap at the start or that no robot can pick.
 /// `check` must hold the meshes and the DAG (LoadProject). Fails like Preprocess.
+/// A new assembly order for a whole project.
+struct OrderSuggestion {
+  std::vector<Step> steps;       ///< The DAG, in assembly order.
+  std::vector<std::string> why;  ///< One line per step: the choice and its reason.
+};
+
+/// The DAG of assembly by disassembly over the project's contact graph (as `wrap new` finds
+/// it, with the grasps of the project's end effectors): each step's inputs, moved and base roles
+/// and free axis; its other mating fields those of the project's first step (defaults when it
+/// has none). `check` must hold the meshes (ValidateProject). Fails with kInfeasible naming the
+/// parts when they are interlocked, kInvalidInput when a mesh did not load.
+Result<OrderSuggestion> SuggestOrder(const Project& project, const ProjectCheck& check);
+
 Result<SuggestResult> SuggestFixes(const Project& project, const ProjectCheck& check,
                                    const std::filesystem::path& project_file);
 

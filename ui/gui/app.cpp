@@ -104,6 +104,7 @@ void App::Frame(render::Image* capture) {
     }
   }
   TakeRun();
+  TakeAuthoring(s_);
   s_.validation.Update(s_.doc.project(), s_.doc.revision(), s_.doc.ResolvePath(), now);
   if (s_.playback.playing && s_.plan) {
     s_.playback.t += dt * s_.playback.speed;
@@ -133,6 +134,8 @@ void App::Frame(render::Image* capture) {
   planner_.Draw(s_, {left_w + centre_w, top + g_h + m_h, right_w, body_h - g_h - m_h});
   StatusBar({0, H - status_h, W, status_h});
   Popups();
+  ImportAssemblyDialog();
+  AuthoringWindows();
   UpdateViewport();
   ChooseQuality();
   UpdateTitle();
@@ -453,6 +456,18 @@ int AfterScriptLine(App& app, const ScriptLine& line, Result<ScriptEffect>& effe
   if (effect->wait_for_planner) {
     while (s.job.running()) app.Frame(nullptr);
     app.TakeRun();
+  }
+  if (effect->wait_for_authoring) {
+    while (s.authoring.running()) {
+      app.Frame(nullptr);
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    if (!s.authoring_log.error.empty()) {
+      err << options.script << ": script line " << line.number << ": " << s.authoring_log.title
+          << ": " << s.authoring_log.error << "\n";
+      return 1;
+    }
+    for (const std::string& l : s.authoring_log.lines) out << "  " << l << "\n";
   }
   if (effect->wait_for_validation) {
     // Frames draw while the worker checks (bounded: a check has no cancel point, but ends).

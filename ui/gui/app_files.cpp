@@ -282,6 +282,7 @@ float App::MenuBar() {
     if (ImGui::MenuItem(redo.c_str(), "Ctrl+Y", false, s_.doc.CanRedo())) s_.doc.Redo();
     ImGui::EndMenu();
   }
+  AssemblyMenu();
   if (ImGui::BeginMenu("View")) {
     if (ImGui::MenuItem("Reset camera")) s_.viewport.ResetCamera();
     ImGui::Separator();
@@ -297,6 +298,10 @@ float App::MenuBar() {
       s_.quality = QualityMode::kFast;
     }
     ImGui::MenuItem("Grippers coloured by wrench utilisation", nullptr, &s_.show_utilisation);
+    ImGui::Separator();
+    ImGui::MenuItem("Assembled view (insertion path of the selected step)", nullptr,
+                    &s_.show_assembled);
+    ImGui::MenuItem("Contacts (assembled)", nullptr, &s_.show_contacts);
     ImGui::Separator();
     if (ImGui::MenuItem("Auto layout of the graph")) graph_.AutoLayout(s_.doc.project());
     if (ImGui::MenuItem("Problems")) s_.focus_problems = true;

@@ -88,6 +88,15 @@ class App {
   Result<void> MatchPlan(const Plan& plan, const std::string& file);
   void LoadRecent();
   void AddRecent(const std::string& file);
+  // app_authoring.cpp
+  void AssemblyMenu();
+  void ImportAssemblyDialog();
+  void AuthoringWindows();
+  // app_geometry.cpp
+  /// The assembled view (parts at their assembled poses, the selected step's moved input at its
+  /// approach pose) and what it draws: contacts, the insertion's swept outline.
+  void AssembledView(SceneState& state, std::vector<render::SceneLine>& lines,
+                     std::vector<render::SceneDot>& dots);
   // app_scene.cpp
   void UpdateViewport();
   std::vector<std::optional<Rgba>> GripperTints(const CellScene& scene) const;
@@ -112,6 +121,11 @@ class App {
   ProblemsPanel problems_;
   ViewportPanel viewport_panel_;
   FileDialog open_dialog_, save_as_dialog_, plan_dialog_;
+  bool assembled_framed_ = false;  // the camera framed the assembly since the view went on
+  bool import_open_ = false;  // open the Import assembly dialog at the next frame
+  std::string import_paths_;  // its mesh files or folder, one per line
+  int import_unit_ = 0;       // auto, mm, cm, m
+  FileBrowser import_dir_;    // its browser
   std::vector<SceneState> plan_states_;
   std::string pending_open_, title_;
   bool confirm_close_ = false, confirm_open_ = false, confirm_new_ = false;

@@ -59,16 +59,26 @@ void App::UpdateViewport() {
   SceneState state;
   const bool failure = FailureState(state, arrows, highlights);
   if (!failure) state = CurrentState();
+  std::vector<render::SceneLine> lines;
+  std::vector<render::SceneDot> dots;
+  const bool assembled = !failure && (s_.show_assembled || s_.show_contacts);
+  if (assembled) {
+    AssembledView(state, lines, dots);
+  } else {
+    assembled_framed_ = false;
+  }
   (void)s_.viewport.SetState(state);
   int selected = -1;
   for (size_t i = 0; i < scene.parts.size(); ++i) {
     if (scene.parts[i].name == s_.selection.part) selected = static_cast<int>(i);
   }
   s_.viewport.set_selected_part(selected);
-  if (!failure) {
+  if (!failure && !assembled) {
     if (auto arrow = StepArrow()) arrows.push_back(*arrow);
     PlanMarks(state, selected, arrows, markers);
   }
+  s_.viewport.set_lines(std::move(lines));
+  s_.viewport.set_dots(std::move(dots));
   s_.viewport.set_arrows(std::move(arrows));
   s_.viewport.set_markers(std::move(markers));
   s_.viewport.set_highlights(std::move(highlights));

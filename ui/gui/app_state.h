@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "gui/authoring_job.h"
 #include "gui/document.h"
 #include "gui/planner_job.h"
 #include "gui/validation_job.h"
@@ -118,6 +119,21 @@ struct AppState {
   std::vector<std::string> recent_files;  ///< Recently opened projects, newest first.
   QualityMode quality = QualityMode::kAuto;  ///< Viewport drawing quality.
   bool show_utilisation = true;  ///< Tint grippers by wrench utilisation during playback.
+  /// View > Assembled view: the parts at their assembled poses on the table's centre, and the
+  /// selected step's insertion path (its moved input at the approach pose, the swept outline
+  /// green where free, red from where it is blocked).
+  bool show_assembled = false;
+  /// View > Contacts: the contact graph drawn in the assembled view (a ball at each contact's
+  /// centre, its normal, a line between the touching parts' centres).
+  bool show_contacts = false;
+  AuthoringJob authoring;  ///< Import assembly, suggest order, lay out (at most one at a time).
+  /// The last authoring edit: what it did or why it did not ("Changes" window, scripts).
+  struct AuthoringLog {
+    std::string title;               ///< E.g. "Suggest assembly order: 4 changes".
+    std::vector<std::string> lines;  ///< What changed, then its decisions.
+    std::string error;               ///< Why nothing was applied ("" when applied).
+  } authoring_log;
+  bool show_authoring_log = false;  ///< The "Changes" window is open.
   FrameStats frames;                       ///< Recent frame times.
 
   /// True when a plan is on show and the document has changed since it was made (a plan for

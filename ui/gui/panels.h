@@ -79,6 +79,23 @@ struct MatingPanel {
   void Draw(AppState& app, const PanelRect& r);
 };
 
+/// The mating editor's geometry: the step's insertion-path verdict from the live validation and,
+/// when blocked, its free directions, each with a button that makes it the axis (undoable).
+/// True when it edited the project (references into the old one are then stale).
+bool StepGeometrySection(AppState& app, const Step& step);
+/// The parts `part` touches where assembled (the live validation's contact graph).
+void PartContactsSection(AppState& app, const std::string& part);
+
+/// Starts an authoring run on the document (Import assembly: `meshes` in `unit`); false with a
+/// message when one is under way.
+bool StartAuthoring(AppState& app, AuthoringKind kind,
+                    std::vector<std::filesystem::path> meshes = {},
+                    LengthUnit unit = LengthUnit::kAuto);
+/// Takes a finished authoring run: applies its project as one undoable edit when the document
+/// has not changed since it started (else says so), and fills the authoring log with what
+/// changed. True when it took one.
+bool TakeAuthoring(AppState& app);
+
 /// Robots: add from the catalog, remove, base pose, end effector, wrench-limit tables.
 struct RobotsPanel {
   int add_model = 0;  ///< Index into RobotModels().

@@ -204,6 +204,7 @@ void PartsPanel::Draw(AppState& app, const PanelRect& r) {
           if (app.Do(RenameNode(part.name, name))) app.selection.part = name;
         }
         ImGui::TextDisabled("mesh: %s", part.mesh.c_str());
+        PartContactsSection(app, part.name);
         bool changed = false;
         changed |= RangedDouble(app, *FindField("part", "scale"), key + "scale", part.scale,
                                 0.0001f, "%.4g");
@@ -283,6 +284,11 @@ void MatingPanel::Draw(AppState& app, const PanelRect& r) {
                         0.01f, "%.2f");
   ImGui::SameLine();
   ImGui::TextDisabled("(assembly frame)");
+  if (StepGeometrySection(app, step)) {
+    ImGui::End();  // the axis was set: `step` belongs to the project before the edit
+    return;
+  }
+  ImGui::Separator();
   struct NumberField {
     const char* name;
     double* value;

@@ -19,7 +19,9 @@ namespace {
 
 // Command name -> (least, most) arguments.
 const std::map<std::string, std::pair<int, int>>& Arity() {
-  static const std::map<std::string, std::pair<int, int>> arity = {{"select", {2, 2}},
+  static const std::map<std::string, std::pair<int, int>> arity = [] {
+    std::map<std::string, std::pair<int, int>> a = GeometryScriptArity();
+    a.insert({{"select", {2, 2}},
                                                                    {"import", {1, 2}},
                                                                    {"add-step", {1, 1}},
                                                                    {"delete-step", {1, 1}},
@@ -59,7 +61,9 @@ const std::map<std::string, std::pair<int, int>>& Arity() {
                                                                    {"expect-plan-current", {0, 0}},
                                                                    {"expect-field-error", {1, 64}},
                                                                    {"expect-undo", {1, 64}},
-                                                                   {"expect-viewport", {1, 1}}};
+                                                                   {"expect-viewport", {1, 1}}});
+    return a;
+  }();
   return arity;
 }
 
@@ -361,6 +365,7 @@ Result<std::vector<ScriptLine>> ParseScript(const std::string& text) {
 Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const fs::path& base) {
   const std::vector<std::string>& w = line.words;
   const std::string& cmd = w[0];
+  if (auto done = RunGeometryScriptLine(app, line, base)) return std::move(*done);
   ScriptEffect effect;
   auto run = [&](const Command& c) -> Result<ScriptEffect> {
     if (auto done = app.doc.Execute(c); !done) return LineError(line, done.error().message);
@@ -417,8 +422,12 @@ Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const 
       app.quality = QualityMode::kFine;
     } else if (w[1] == "quality" && w[2] == "fast") {
       app.quality = QualityMode::kFast;
+    } else if ((w[1] == "assembled" || w[1] == "contacts") && (w[2] == "on" || w[2] == "off")) {
+      (w[1] == "assembled" ? app.show_assembled : app.show_contacts) = w[2] == "on";
     } else {
-      return LineError(line, "view utilisation on|off, or view quality auto|fine|fast");
+      return LineError(line,
+                       "view utilisation|assembled|contacts on|off, or view quality "
+                       "auto|fine|fast");
     }
     return effect;
   }

@@ -46,10 +46,25 @@
 //   expect-field-error FIELD [TEXT...] a refusal is shown at FIELD (e.g. mating.s1.force_N)
 //   expect-undo TEXT...                the Edit menu's undo label holds TEXT
 //   expect-viewport cell|empty         the viewport has a cell drawn, or none
+//   view assembled|contacts on|off     View > Assembled view (insertion path of the selected
+//                                      step), View > Contacts
+//   import-assembly UNIT PATH...       Assembly > Import assembly (UNIT auto|mm|cm|m; mesh files
+//                                      or a folder), waiting for it; fails when nothing applied
+//   suggest-order | lay-out            Assembly > Suggest assembly order, > Lay out parts on the
+//                                      table, waiting for them; fail when nothing applied
+//   use-free-direction STEP N          the mating editor's "Use" button of the Nth free direction
+//                                      (as listed, from 1; needs a current `validate`)
+//   expect-path STEP free|blocked      the validation's verdict on the step's insertion path
+//   expect-free-direction STEP X Y Z   that direction is among the step's free directions
+//   expect-touch A B | expect-no-touch A B   parts A and B touch (the contact graph) or not
+//   expect-count parts|steps|robots N  the project has N of them
+//   expect-change TEXT...              the last authoring edit's changes or decisions say TEXT
 #pragma once
 
 #include <filesystem>
 #include <functional>
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,11 +92,18 @@ struct ScriptEffect {
   bool new_document = false;         ///< File > New.
   std::filesystem::path open;        ///< File > Open this project.
   bool wait_for_validation = false;  ///< Hold the script until the live validation is current.
+  bool wait_for_authoring = false;   ///< Hold the script until the authoring run is taken.
   std::string measure;               ///< Measure the frame rate: "idle", "orbit" or "play".
   double measure_s = 0.0;            ///< ... for this long [s].
   /// A check of what the next frame drew (run after it); fails the line with its message.
   std::function<Result<void>(const AppState&)> check;
 };
+
+/// The geometry and authoring commands (script_authoring.cpp): their arity by name.
+const std::map<std::string, std::pair<int, int>>& GeometryScriptArity();
+/// Runs one of them (nullopt when `line` is another command).
+std::optional<Result<ScriptEffect>> RunGeometryScriptLine(AppState& app, const ScriptLine& line,
+                                                         const std::filesystem::path& base_dir);
 
 /// Runs one line against `app`; relative paths resolve against `base_dir`. A refused edit fails
 /// with its reason (kInvalidInput), prefixed by the line number.

@@ -47,7 +47,9 @@ void LiveValidation::Start(const Project& project, unsigned long revision,
     r.revision = revision;
     r.project = snapshot;
     try {
-      r.diagnostics = CheckProject(*snapshot, file).diagnostics;
+      auto geometry = std::make_shared<GeometryReport>();
+      r.diagnostics = CheckProject(*snapshot, file, geometry.get()).diagnostics;
+      r.geometry = std::move(geometry);
     } catch (const std::exception& e) {
       r.diagnostics.Error(file.string(), "",
                           std::string("internal error while checking: ") + e.what());

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "core/diagnostics.h"
+#include "mating/check.h"
 #include "model/project.h"
 
 namespace wrap::gui {
@@ -21,6 +22,9 @@ struct ValidationResult {
   unsigned long revision = 0;              ///< Document revision that was checked (0: none yet).
   std::shared_ptr<const Project> project;  ///< The project as it was checked.
   double seconds = 0.0;                    ///< How long the check took [s].
+  /// What the geometry's checks found (contacts, each step's insertion path and free
+  /// directions), as CheckProject computed it; null before the first check.
+  std::shared_ptr<const GeometryReport> geometry;
 };
 
 /// One validation at a time on a std::jthread, started by Update when the document has been

@@ -11,7 +11,7 @@
 namespace wrap::render {
 
 namespace {
-constexpr int kExtraGeoms = 64;  // arrows and markers added after mjv_updateScene
+constexpr int kExtraGeoms = 600;  // arrows, markers, lines, dots added after mjv_updateScene
 constexpr int kFineSamples = 4;  // multisampling of fine drawing
 }  // namespace
 
@@ -58,6 +58,39 @@ struct ViewportRenderer::Impl {
     context_made = scene_made = false;
   }
 };
+
+// Lines (thin capsules) and dots (balls) appended to the scene as decor.
+static void AddLinesAndDots(const std::vector<SceneLine>& lines, const std::vector<SceneDot>& dots,
+                     mjvScene& scene) {
+  auto rgba_of = [](const Rgba& c, float out[4]) {
+    for (int i = 0; i < 4; ++i) out[i] = static_cast<float>(c[i]);
+  };
+  for (const SceneLine& line : lines) {
+    if (scene.ngeom >= scene.maxgeom) return;
+    if ((line.to_W - line.from_W).norm() < 1e-6) continue;
+    mjvGeom* geom = scene.geoms + scene.ngeom;
+    float rgba[4];
+    rgba_of(line.color, rgba);
+    mjv_initGeom(geom, mjGEOM_CAPSULE, nullptr, nullptr, nullptr, rgba);
+    mjv_makeConnector(geom, mjGEOM_CAPSULE, line.width_m, line.from_W.x(), line.from_W.y(),
+                      line.from_W.z(), line.to_W.x(), line.to_W.y(), line.to_W.z());
+    geom->category = mjCAT_DECOR;
+    geom->emission = 0.5f;
+    scene.ngeom++;
+  }
+  for (const SceneDot& dot : dots) {
+    if (scene.ngeom >= scene.maxgeom) return;
+    mjvGeom* geom = scene.geoms + scene.ngeom;
+    float rgba[4];
+    rgba_of(dot.color, rgba);
+    const mjtNum size[3] = {dot.radius_m, dot.radius_m, dot.radius_m};
+    const mjtNum pos[3] = {dot.at_W.x(), dot.at_W.y(), dot.at_W.z()};
+    mjv_initGeom(geom, mjGEOM_SPHERE, size, pos, nullptr, rgba);
+    geom->category = mjCAT_DECOR;
+    geom->emission = 0.5f;
+    scene.ngeom++;
+  }
+}
 
 ViewportRenderer::ViewportRenderer() = default;
 ViewportRenderer::~ViewportRenderer() = default;
@@ -157,6 +190,16 @@ void ViewportRenderer::ResetCamera() {
   if (!ready()) return;
   const CameraView view =
       FrameBox(SceneBounds(impl_->scene, InitialState(impl_->scene)), 105.0, -35.0, 40.0, 1.4, 1.0);
+  impl_->camera.type = mjCAMERA_FREE;
+  for (int i = 0; i < 3; ++i) impl_->camera.lookat[i] = view.lookat[i];
+  impl_->camera.azimuth = view.azimuth_deg;
+  impl_->camera.elevation = view.elevation_deg;
+  impl_->camera.distance = view.distance_m;
+}
+
+void ViewportRenderer::FrameBounds(const Aabb& bounds) {
+  if (!ready()) return;
+  const CameraView view = FrameBox(bounds, 105.0, -35.0, 40.0, 1.4, 1.6);
   impl_->camera.type = mjCAMERA_FREE;
   for (int i = 0; i < 3; ++i) impl_->camera.lookat[i] = view.lookat[i];
   impl_->camera.azimuth = view.azimuth_deg;
@@ -291,6 +334,7 @@ void ViewportRenderer::Draw(int x, int y, int width, int height) {
       geom->category = mjCAT_DECOR;
       s.mjscene.ngeom++;
     }
+    AddLinesAndDots(lines_, dots_, s.mjscene);
     // Drawn offscreen, then copied into the window's rectangle (resolving the multisampling).
     mjr_setBuffer(mjFB_OFFSCREEN, &s.context);
     const mjrRect off{0, 0, width, height};

@@ -33,6 +33,21 @@ struct SceneMarker {
   Rgba color = {0.1, 0.6, 0.9, 0.6};  ///< Colour (translucent).
 };
 
+/// A thin straight segment (an insertion's swept outline, a contact between two parts).
+struct SceneLine {
+  Vec3 from_W = Vec3::Zero();           ///< One end, world [m].
+  Vec3 to_W = Vec3::Zero();             ///< The other end, world [m].
+  Rgba color = {0.2, 0.85, 0.3, 1.0};   ///< Colour.
+  double width_m = 0.0015;              ///< Thickness [m].
+};
+
+/// A small ball (e.g. the centre of a contact).
+struct SceneDot {
+  Vec3 at_W = Vec3::Zero();            ///< Centre, world [m].
+  double radius_m = 0.005;             ///< [m].
+  Rgba color = {1.0, 0.85, 0.1, 1.0};  ///< Colour.
+};
+
 /// Something of the scene drawn in a colour (e.g. the robot that could not reach, the bodies
 /// that collided), glowing so it shows on any colour.
 struct SceneHighlight {
@@ -82,6 +97,9 @@ class ViewportRenderer {
   void set_arrows(std::vector<SceneArrow> arrows) { arrows_ = std::move(arrows); }
   /// Discs drawn on the table (placements).
   void set_markers(std::vector<SceneMarker> markers) { markers_ = std::move(markers); }
+  /// Segments and balls drawn into the scene (decor, never picked).
+  void set_lines(std::vector<SceneLine> lines) { lines_ = std::move(lines); }
+  void set_dots(std::vector<SceneDot> dots) { dots_ = std::move(dots); }
   /// Per robot (scene order), a colour the robot's end effector (gripper body, fingers, cup) is
   /// tinted with, e.g. its wrench utilisation during playback; absent or nullopt: its own colours.
   void set_gripper_tints(std::vector<std::optional<Rgba>> tints) { tints_ = std::move(tints); }
@@ -99,6 +117,8 @@ class ViewportRenderer {
   void Zoom(double d);
   /// Frames the whole cell from the default direction.
   void ResetCamera();
+  /// Frames `bounds` (world) tightly from the default direction (e.g. the assembled view).
+  void FrameBounds(const Aabb& bounds);
   /// The camera as it stands (azimuth, elevation [deg], distance [m], look-at point).
   CameraView camera() const;
   /// The free camera's vertical field of view [deg] (45 before any cell).
@@ -110,6 +130,8 @@ class ViewportRenderer {
   int selected_part_ = -1;
   std::vector<SceneArrow> arrows_;
   std::vector<SceneMarker> markers_;
+  std::vector<SceneLine> lines_;
+  std::vector<SceneDot> dots_;
   std::vector<std::optional<Rgba>> tints_;
   std::vector<SceneHighlight> highlights_;
   DrawQuality quality_ = DrawQuality::kFine;
