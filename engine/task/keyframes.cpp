@@ -286,12 +286,10 @@ bool KeyframeSolver::SoloReach(int robot, const std::vector<PlanObject>& objects
   return ok;
 }
 
-bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objects, int mating_step,
-                            std::uint64_t key, std::string* reason) {
-  if (options_.wrench_mode == MatingWrenchMode::kNone) return true;
+Result<WrenchCheck> KeyframeSolver::CountedCheck(WrenchGate gate, std::uint64_t key,
+                                                 const StepConfiguration& config) {
   ++counters_.lp_checks;
   const auto start = Clock::now();
-  const StepConfiguration config = BuildWrenchConfig(world_, tables_, objects, mating_step);
   WrenchQuery query;
   query.gate = gate;
   query.mode = options_.wrench_mode;
@@ -305,6 +303,14 @@ bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objec
   counters_.lp_cache_hits += static_cast<long long>(checker_.cache_hits() - hits);
   counters_.lp_solves += static_cast<long long>(checker_.lp_solves() - solves);
   counters_.lp_pivots += static_cast<long long>(checker_.lp_pivots() - pivots);
+  return result;
+}
+
+bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objects, int mating_step,
+                            std::uint64_t key, std::string* reason) {
+  if (options_.wrench_mode == MatingWrenchMode::kNone) return true;
+  const StepConfiguration config = BuildWrenchConfig(world_, tables_, objects, mating_step);
+  auto result = CountedCheck(gate, key, config);
   if (!result) {
     if (reason) *reason = result.error().message;
     return false;
@@ -336,21 +342,8 @@ bool KeyframeSolver::MatingIncrementFits(int step,
                                 {s.base, Iso3::Identity(), false, base_holders}};
   const StepConfiguration config = BuildWrenchConfig(world_, tables_, objs, step);
   if (!HeldThenMated(config)) return true;  // A relaxation of that check only.
-  ++counters_.lp_checks;
-  const auto start = Clock::now();
-  const std::uint64_t hits = checker_.cache_hits();
-  const std::uint64_t solves = checker_.lp_solves();
-  const std::uint64_t pivots = checker_.lp_pivots();
-  WrenchQuery query;
-  query.gate = WrenchGate::kAssembly;
-  query.mode = options_.wrench_mode;
-  query.lambda = options_.force_scale;
-  auto result = checker_.CheckCached(HashMix(key, 0x6d6174696e67ULL),
-                                     MatingIncrementRelaxation(config), query);
-  counters_.t_lp_s += Seconds(start);
-  counters_.lp_cache_hits += static_cast<long long>(checker_.cache_hits() - hits);
-  counters_.lp_solves += static_cast<long long>(checker_.lp_solves() - solves);
-  counters_.lp_pivots += static_cast<long long>(checker_.lp_pivots() - pivots);
+  auto result = CountedCheck(WrenchGate::kAssembly, HashMix(key, 0x6d6174696e67ULL),
+                             MatingIncrementRelaxation(config));
   return !result || result->feasible;  // An error: no conclusion from the relaxation.
 }
 

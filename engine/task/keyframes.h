@@ -150,6 +150,10 @@ class KeyframeSolver {
     int grasp = -1;
   };
   struct Attempt;
+  /// The checker's answer for `config` at `gate` (cached by `key`, 0: by content), counted in
+  /// the counters (checks, hits, LPs, pivots, t_lp).
+  Result<WrenchCheck> CountedCheck(WrenchGate gate, std::uint64_t key,
+                                   const StepConfiguration& config);
   bool SolveIk(int robot, const Iso3& X_WT, const JointVector& reference, int effort,
                std::mt19937_64& rng, std::vector<JointVector>& out);
   void SetScene(const std::vector<PlanObject>& objects,

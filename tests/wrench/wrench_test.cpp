@@ -259,7 +259,8 @@ TEST(WrenchVacuum, TransportWithAccelerationMargin) {
 
 // Inserting a part held by a vacuum cup from above: the axial push is fine in assembly mode, a
 // transverse component is not.
-TEST(WrenchVacuum, AssemblyModeRejectsTransverseMatingForce) {
+// A peg on a vacuum cup mated into a seat held by fingers, in the air.
+StepConfiguration CupPegIntoHeldSeat(double transverse) {
   StepConfiguration c;
   c.bodies.push_back({"peg", 0.5, Vec3(0, 0, 0.2)});
   c.bodies.push_back({"seat", 1.0, Vec3(0, 0, 0.05)});
@@ -273,7 +274,13 @@ TEST(WrenchVacuum, AssemblyModeRejectsTransverseMatingForce) {
   m.axis_W = -Vec3::UnitZ();
   m.p_WContact = Vec3(0, 0, 0.1);
   m.force_N = 10.0;
+  m.transverse_fraction = transverse;
   c.mating = m;
+  return c;
+}
+
+TEST(WrenchVacuum, AssemblyModeRejectsTransverseMatingForce) {
+  StepConfiguration c = CupPegIntoHeldSeat(0.0);
   const WrenchCheck axial = MustCheck(c);
   EXPECT_TRUE(axial.feasible) << axial.reason;
   // The cup pushes the peg down with F - m g = 10 - 4.905 N (z_G points down) of its 110 N.
@@ -694,26 +701,6 @@ StepConfiguration Turned(const StepConfiguration& c, const Mat3& R) {
     out.mating->p_WContact = R * out.mating->p_WContact;
   }
   return out;
-}
-
-// A peg on a vacuum cup mated into a seat held by fingers, in the air.
-StepConfiguration CupPegIntoHeldSeat(double transverse) {
-  StepConfiguration c;
-  c.bodies.push_back({"peg", 0.5, Vec3(0, 0, 0.2)});
-  c.bodies.push_back({"seat", 1.0, Vec3(0, 0, 0.05)});
-  c.grippers.push_back(MakeGripper("r1", 0, At(Vec3(0, 0, 0.25), RotX(std::numbers::pi)),
-                                   EndEffectorKind::kVacuum, WrenchLimits{}));
-  c.grippers.push_back(
-      MakeGripper("r2", 1, At(Vec3(0, 0, 0.05)), EndEffectorKind::kTwoFinger, WrenchLimits{}));
-  MatingLoad m;
-  m.moved = 0;
-  m.base = 1;
-  m.axis_W = -Vec3::UnitZ();
-  m.p_WContact = Vec3(0, 0, 0.1);
-  m.force_N = 10.0;
-  m.transverse_fraction = transverse;
-  c.mating = m;
-  return c;
 }
 
 // A cup takes no transverse force while mating (paper's vacuum table), so a transverse mating
