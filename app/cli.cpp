@@ -88,6 +88,11 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       plan->add_option("--seed", plan_seed, "Random seed (default: the project's)");
   CLI::Option* plan_time_option = plan->add_option(
       "--time-limit", plan_time_limit, "Time limit in seconds (default: the project's)");
+  plan->add_option("--budget", plan_args.budget,
+                   "Scale of the work budgets of the motion searches (default 1): collision "
+                   "checks per path search, poses per carry search. The budgets, not the "
+                   "machine's speed, decide the plan; --time-limit is an outer wall-clock bound")
+      ->check(CLI::PositiveNumber);
   plan->add_option("--wrench", plan_args.wrench,
                    "Wrench model: full (default), gravity (gravity only) or none");
   plan->add_option("--force-scale", plan_args.force_scale,

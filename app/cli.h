@@ -88,6 +88,7 @@ struct PlanArgs {
   std::string output;                 ///< -o PLAN.json (atomic); empty: not written.
   std::optional<std::uint64_t> seed;  ///< --seed; absent: the project's planner.seed.
   std::optional<double> time_limit;   ///< --time-limit [s]; absent: the project's.
+  double budget = 1.0;                ///< --budget: scale of the motion searches' work budgets.
   std::string wrench = "full";        ///< --wrench full|gravity|none.
   double force_scale = 1.0;           ///< --force-scale lambda.
   std::string planner = "wrap";       ///< --planner variant.

@@ -119,7 +119,8 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
 
   out << "Planning '" << p.name << "' (" << options.planner << ", seed " << seed << ", wrench "
       << args.wrench << ", lambda " << Fmt("%g", options.force_scale) << ", time limit "
-      << Fmt("%g", time_limit) << " s)\n";
+      << Fmt("%g", time_limit) << " s"
+      << (args.budget != 1.0 ? ", budget x" + Fmt("%g", args.budget) : std::string()) << ")\n";
   PreprocessOptions pre_options;
   pre_options.project_file = args.project;
   pre_options.grasps = args.grasps;
@@ -137,6 +138,7 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   pipeline.task = options;
   pipeline.task_only = args.task_only;
   pipeline.seed = seed;
+  pipeline.budget = args.budget;
   const auto t_plan = std::chrono::steady_clock::now();
   auto plan = PlanAssembly(p, loaded.check, *pre, pipeline, ctx);
   const double t_planning =

@@ -21,10 +21,11 @@ struct MotionAttempt {
   double t_retime_s = 0.0;  ///< Retiming [s].
 };
 
-/// Plans the motion of `plan` at effort level `effort` (the free paths' budget is
-/// options.segment_time_s * 2^effort; `cache` keeps the paths solved by earlier attempts on the
-/// same plan). On success fills plan.trajectories, plan.segments, every action's start_s and
-/// end_s, and the stats' makespan_s, makespan_sequential_s, motion_segments and motion = true.
+/// Plans the motion of `plan` at effort level `effort` (the searches' work budgets,
+/// options.segment_checks and carry_edges, double per level; `cache` keeps the paths solved by
+/// earlier attempts on the same plan). On success fills plan.trajectories, plan.segments, every
+/// action's start_s and end_s, and the stats' makespan_s, makespan_sequential_s, motion_segments
+/// and motion = true.
 /// With options.self_check, timed trajectories that fail the independent check are not kept:
 /// the attempt fails (segment "timed", not to be retried) naming the first issue.
 /// Fails with kCancelled when ctx is cancelled, kInvalidInput when the plan does not fit the world.

@@ -17,7 +17,6 @@
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
 #include <ompl/util/Console.h>
 
-#include "core/run_context.h"
 namespace wrap {
 
 namespace ob = ompl::base;
@@ -250,19 +249,18 @@ PathAnswer PlanPath(const PathQuery& query) {
   planner->setRange(query.range_per_sqrt_dim * std::sqrt(static_cast<double>(dim)));
   planner->setProblemDefinition(pdef);
   planner->setup();
-  // The budget is this thread's CPU time (a loaded machine slows the search, it does not cut
-  // it short); cancellation and the run's deadline come through query.stop.
-  const double cpu_deadline = ThreadCpuSeconds() + query.time_limit_s;
+  // The budget is work (validity checks), not time: a loaded machine slows the search, it does
+  // not change what it finds. Cancellation and the run's deadline come through query.stop.
   ob::PlannerTerminationCondition ptc(
-      [&] { return ThreadCpuSeconds() >= cpu_deadline || (query.stop && query.stop()); });
+      [&] { return out.checks >= query.max_checks || (query.stop && query.stop()); });
   std::uint64_t attempt_seed = seed;
   while (true) {
     const ob::PlannerStatus status = planner->solve(ptc);
     if (status != ob::PlannerStatus::EXACT_SOLUTION) {
       out.timed_out = !(query.stop && query.stop());
-      out.why = out.timed_out ? "RRT-Connect found no path within " +
-                                    std::to_string(query.time_limit_s).substr(0, 4) + " s"
-                              : "cancelled";
+      out.why = out.timed_out ? "RRT-Connect found no path within its budget of " +
+                                    std::to_string(query.max_checks) + " collision checks"
+                              : "stopped (cancelled or past the time limit)";
       return out;
     }
     const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();

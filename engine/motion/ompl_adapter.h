@@ -28,9 +28,12 @@ struct PathQuery {
   /// The returned path is checked at this finer resolution (shortcuts too); a path that fails
   /// it is not returned. 0: the same as `resolution`.
   double final_resolution = 0.0;
-  double time_limit_s = 1.0;  ///< RRT-Connect's budget: CPU time of the calling thread [s].
+  /// RRT-Connect's work budget: state validity checks (its states and motions, the re-checks
+  /// of the paths it returns). Counted in work, not time, so that the same seed finds the same
+  /// path whatever the machine's load; the run's deadline comes through `stop`.
+  long long max_checks = 20000;
   std::uint64_t seed = 0;     ///< Seeds sampling and shortcutting (deterministic per seed).
-  /// Checked while planning: true stops at once (cancellation).
+  /// Checked while planning: true stops at once (cancellation, the run's wall-clock deadline).
   std::function<bool()> stop;
   /// Random shortcut attempts after the path is found and shortcut greedily (each waypoint
   /// straight to the farthest later one it sees).
@@ -46,7 +49,7 @@ struct PathQuery {
 /// What PlanPath found.
 struct PathAnswer {
   bool solved = false;                ///< A path was found.
-  bool timed_out = false;             ///< Not solved within the budget (more effort may help).
+  bool timed_out = false;  ///< Not solved within the work budget (more effort may help).
   std::vector<Eigen::VectorXd> path;  ///< Waypoints from start to goal (solved only).
   /// The goal reached: 0 for `goal`, k for `other_goals[k - 1]` (solved only).
   int goal_index = 0;
@@ -60,11 +63,10 @@ bool StraightMotionValid(const PathQuery& query, const Eigen::VectorXd& a, const
                          long long* checks = nullptr);
 
 /// A path from query.start to query.goal: the straight motion when it is valid, else RRT-Connect
-/// (OMPL) within the time limit, then shortcutting (random pairs of points along the path joined
+/// (OMPL) within the work budget, then shortcutting (random pairs of points along the path joined
 /// by straight motions) and removal of waypoints whose neighbours see each other; every piece of
 /// the result is valid at `final_resolution` (RRT-Connect is run again with a new seed, within
-/// the time limit, while its path is not). Deterministic for a given seed when it does not run out
-/// of time.
+/// the budget, while its path is not). Deterministic for a given seed unless `stop` stops it.
 PathAnswer PlanPath(const PathQuery& query);
 
 }  // namespace wrap

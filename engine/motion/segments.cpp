@@ -169,7 +169,8 @@ class Builder {
                                                   const Iso3& X_a, const Iso3& X_b);
   // A carry the straight variants could not make: a tree of object poses grown from the start
   // (RRT with goal bias, each edge tracked by the holders' IK and checked for collisions), then
-  // shortcut. Budget: segment_time_s * 2^effort. The path on success (empty otherwise).
+  // shortcut. Budget: carry_edges * 2^(effort - 1) edges tried. The path on success (empty
+  // otherwise).
   std::vector<std::vector<JointVector>> CarrySearch(
       const std::vector<int>& holders, const Iso3& X_start, const Iso3& X_goal,
       const std::vector<JointVector>& goal_q, const Keyframe& target,
@@ -756,7 +757,7 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
       return !scene_.Collides(who);
     };
     query.resolution = opt_.resolution_rad;
-    query.time_limit_s = opt_.segment_time_s * std::pow(2.0, effort_);
+    query.max_checks = opt_.segment_checks << effort_;
     query.seed = Mix(seed_, static_cast<std::uint64_t>(index) * 2 + (who.size() > movers.size()));
     if (auto it = cache_.reseed.find(index); it != cache_.reseed.end()) {
       query.seed = Mix(query.seed, 0x7265736565640000ULL + static_cast<std::uint64_t>(it->second));
@@ -1088,8 +1089,7 @@ std::vector<std::vector<JointVector>> Builder::CarrySearch(
   const Eigen::Quaterniond qg(X_goal.linear());
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::normal_distribution<double> n01(0.0, 1.0);
-  const double budget_s = opt_.segment_time_s * std::pow(2.0, effort_);  // thread CPU time
-  const double cpu0 = ThreadCpuSeconds();
+  const int budget = opt_.carry_edges << std::max(0, effort_ - 1);  // edges tried
   const auto t0 = std::chrono::steady_clock::now();
   constexpr double kStepM = 0.08;  // longest edge in the metric [m]
   constexpr int kMaxNodes = 4000;
@@ -1098,7 +1098,7 @@ std::vector<std::vector<JointVector>> Builder::CarrySearch(
   int edges = 0;
   std::string end_why;
   while (goal_node < 0 && static_cast<int>(tree.size()) < kMaxNodes && !ctx_.ShouldStop() &&
-         ThreadCpuSeconds() - cpu0 < budget_s) {
+         edges < budget) {
     const bool to_goal = u(rng_) < 0.2;
     Iso3 X_rand = X_goal;
     if (!to_goal) {

@@ -32,9 +32,14 @@ struct MotionOptions {
   /// checked states differ by at most this in every joint [rad]; skills and final paths are
   /// checked 4 times finer. (The trajectory check samples at 0.02 rad.)
   double resolution_rad = 0.01;
-  double segment_time_s = 0.5;      ///< Search budget per free segment or carry at effort 0
-                                    ///< (thread CPU time) [s].
-  int max_effort = 3;               ///< Effort levels 0..max_effort; the budget doubles per level.
+  /// Work budget of a free segment's path search at effort 0: collision checks (RRT-Connect's
+  /// states and motions). Budgets count work, not time, so that the same project, options and
+  /// seed give the same plan whatever the machine's load, its cores or a sanitizer's slowdown.
+  long long segment_checks = 200000;
+  /// Work budget of the search over a carried object's poses at effort 1 (it runs from effort
+  /// 1 on): edges tried, each tracked by the holders' IK and checked for collisions.
+  int carry_edges = 500;
+  int max_effort = 3;  ///< Effort levels 0..max_effort; the budgets double per level.
   double approach_m = 0.04;         ///< Straight approach to (and retreat from) a grasp [m].
   double lift_m = 0.02;             ///< Straight lift off (and descent onto) the table [m].
   double cartesian_step_m = 0.004;  ///< Spacing of IK samples along a straight move [m].

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -90,6 +91,10 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
   }
   auto world = BuildTaskWorld(project, check, pre, options.task.project_file);
   if (!world) return std::unexpected(world.error());
+  MotionOptions motion = options.motion;
+  motion.segment_checks = std::max(1LL, std::llround(motion.segment_checks * options.budget));
+  motion.carry_edges =
+      std::max(1, static_cast<int>(std::lround(motion.carry_edges * options.budget)));
 
   std::vector<Candidate> queue;
   int made = 1;
@@ -134,7 +139,7 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
     // New plans and more effort take turns: while the least effort in the queue is e, up to
     // 4 + 4 e task plans are made before the suspended ones get more effort.
     bool all_suspended = !queue.empty();
-    int least_effort = options.motion.max_effort;
+    int least_effort = motion.max_effort;
     for (const Candidate& c : queue) {
       all_suspended = all_suspended && c.effort > 0;
       least_effort = std::min(least_effort, c.effort);
@@ -184,7 +189,7 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
                  "task plan " + std::to_string(c.order + 1) + " of " + std::to_string(made) +
                      ", effort " + std::to_string(c.effort) + " (" + std::to_string(suspensions) +
                      " suspensions so far)");
-    auto attempt = PlanMotion(*world, c.plan, options.motion, c.effort,
+    auto attempt = PlanMotion(*world, c.plan, motion, c.effort,
                               c.plan.stats.seed ^ 0x4d50ULL, c.cache, ctx);
     if (!attempt) {
       if (attempt.error().code == ErrorCode::kCancelled) return std::unexpected(attempt.error());
@@ -207,7 +212,7 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
         "action " + std::to_string(f.action + 1) + ", " + f.segment + " segment: " + f.message;
     last_detail = MotionFailureRecord(c.plan, f, last_failure);
     ctx.Progress("motion", -1.0,
-                 (f.suspend && c.effort < options.motion.max_effort ? "suspended: " : "failed: ") +
+                 (f.suspend && c.effort < motion.max_effort ? "suspended: " : "failed: ") +
                      last_failure);
     if (std::getenv("WRAP_MOTION_DEBUG")) {
       std::fprintf(stderr, "[motion] plan %d effort %d: %s%s\n", c.order, c.effort,
@@ -217,7 +222,7 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
     const std::uint64_t edge = blame >= 0 && blame < static_cast<int>(c.plan.actions.size())
                                    ? c.plan.actions[blame].edge
                                    : 0;
-    if (f.suspend && c.effort < options.motion.max_effort) {
+    if (f.suspend && c.effort < motion.max_effort) {
       ++c.effort;  // Suspend: more effort later
       ++suspensions;
       c.stuck = edge;
@@ -236,7 +241,8 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
   plan.stats.task_plans = made;
   plan.stats.failure = "no motion for the task plan" + std::string(made > 1 ? "s" : "") +
                        " found (" + std::to_string(made) + " tried" +
-                       (ctx.timed_out() ? ", time limit reached" : "") +
+                       (ctx.timed_out() ? ", time limit reached before the work budgets were spent"
+                                        : ", work budgets spent; --budget gives more") +
                        "); last: " + (last_failure.empty() ? "none planned" : last_failure);
   if (last_detail) {
     last_detail->text = plan.stats.failure;

@@ -1,7 +1,7 @@
 // The planner as one call (paper Algorithm 1, "High level search of WRAP"): task plans from the
 // task planner (NextTaskPlan), each with its keyframes optimised jointly, queued with an effort
 // level; the motion planner takes the queued plan with the least effort (SelectFairly), and a plan
-// whose free path search runs out of time is suspended and retried later with twice the budget,
+// whose free path search spends its work budget is suspended and retried later with twice it,
 // while further task plans join the queue. The first plan with motion is returned.
 #pragma once
 
@@ -27,6 +27,10 @@ struct PipelineOptions {
   bool task_only = false;          ///< Stop after the task plan (no keyframe optimisation, motion).
   bool optimize_keyframes = true;  ///< Run the joint keyframe optimisation before motion.
   int max_task_plans = 32;  ///< Task plans the loop may ask for (the first with ctx's generator).
+  /// Scale of the motion searches' work budgets (MotionOptions::segment_checks, carry_edges):
+  /// 2 searches twice as long before a plan is suspended or given up. The run's time limit
+  /// (ctx's deadline) stays wall-clock, an outer bound; the budgets decide the plan.
+  double budget = 1.0;
   /// The run's seed (ctx's): recorded in the stats; further task plans and the motion planner's
   /// sampling derive their seeds from it.
   std::uint64_t seed = 0;

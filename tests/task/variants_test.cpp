@@ -132,7 +132,6 @@ TEST(FlatLazy, StopsAtTheMemoryLimitAndSaysSo) {
     EXPECT_TRUE(st.out_of_memory) << project;
     EXPECT_NE(st.failure.find("out of memory"), std::string::npos) << st.failure;
     EXPECT_NE(st.failure.find("16 MiB"), std::string::npos) << st.failure;
-    EXPECT_LT(st.t_init_s, 60.0);
   }
 }
 

@@ -93,6 +93,18 @@ void PlannerPanel::Draw(AppState& app, const PanelRect& r) {
   ImGui::SetNextItemWidth(120);
   ImGui::InputDouble("time limit [s]", &q.time_limit_s, 1.0, 10.0, "%.0f");
   q.time_limit_s = std::clamp(q.time_limit_s, 1.0, 36000.0);
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip("Wall-clock bound of the whole run. The work budget, not the machine's "
+                      "speed, decides the plan; this only stops a run that takes too long.");
+  }
+  ImGui::SetNextItemWidth(120);
+  ImGui::InputDouble("work budget x", &q.budget, 0.5, 2.0, "%.2g");
+  q.budget = std::clamp(q.budget, 0.01, 1000.0);
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip("Scale of the motion searches' budgets (collision checks per path search, "
+                      "poses per carry search), as `wrap plan --budget`. More finds paths in "
+                      "harder scenes; the same budget and seed give the same plan on any machine.");
+  }
   ImGui::SetNextItemWidth(120);
   ImGui::InputScalar("seed", ImGuiDataType_U64, &q.seed);
   ImGui::SetNextItemWidth(120);

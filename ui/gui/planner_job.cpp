@@ -198,6 +198,7 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
     pipeline.task = task;
     pipeline.task_only = request.task_only;
     pipeline.seed = request.seed;
+    pipeline.budget = request.budget;
     auto plan = PlanAssembly(project, check, *pre, pipeline, ctx);
     if (stopped()) return;
     if (!plan) {

@@ -25,7 +25,8 @@ struct PlannerRequest {
   std::string planner = "wrap";  ///< Variant: wrap, optimistic, flat, counting, exact, fine.
   std::string wrench = "full";   ///< Wrench model: full, gravity, none.
   double force_scale = 1.0;      ///< Lambda on the mating force.
-  double time_limit_s = 60.0;    ///< Time limit of the whole run [s].
+  double time_limit_s = 60.0;    ///< Time limit of the whole run (wall clock, an outer bound) [s].
+  double budget = 1.0;           ///< Scale of the motion searches' work budgets (`--budget`).
   std::uint64_t seed = 0;        ///< Random seed.
   int grasps = 0;                ///< Grasp-set size; 0: the project's.
   bool optimize = false;         ///< Improve the first plan until the time limit.

@@ -461,6 +461,8 @@ Result<ScriptEffect> RunScriptLine(AppState& app, const ScriptLine& line, const 
       q.time_limit_s = std::atof(v.c_str());
     else if (w[1] == "seed")
       q.seed = std::strtoull(v.c_str(), nullptr, 10);
+    else if (w[1] == "budget")
+      q.budget = std::atof(v.c_str());
     else if (w[1] == "task_only")
       q.task_only = v == "1" || v == "true";
     else if (w[1] == "grasps")
