@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The README's commands: install the dependencies, build, then run the demo or the tests.
-#   scripts/dev.sh demo   install, build, and run the main job on the built-in stool example:
-#                         validate, describe, plan (validated) and render the plan's keyframes
-#                         and the goal into out/stool/
+#   scripts/dev.sh demo   install, build `wrap` (not the tests), and run the main job on the
+#                         built-in stool example: validate, describe, plan (validated) and
+#                         render the plan's keyframes and the goal into out/stool/
 #   scripts/dev.sh test   install, build, and run the whole test suite (what CI runs)
 #   scripts/dev.sh build  install and build only
 #   scripts/dev.sh sanitize     install, build everything with ASan + UBSan (-DWRAP_SANITIZE=ON)
@@ -62,7 +62,12 @@ esac
 
 BUILD_DIR=${BUILD_DIR:-build}
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE"
-cmake --build "$BUILD_DIR" --parallel "$(nproc)"
+if [[ "$mode" == demo ]]; then
+  # The demo needs the command line only: the tests, benchmarks and GUI are built by `test`.
+  cmake --build "$BUILD_DIR" --parallel "$(nproc)" --target wrap
+else
+  cmake --build "$BUILD_DIR" --parallel "$(nproc)"
+fi
 
 case "$mode" in
   build) ;;

@@ -56,7 +56,9 @@ class RunContext {
   void Progress(const std::string& stage, double fraction, const std::string& message) const {
     if (progress_) progress_(stage, fraction, message);
   }
-  /// The run's random generator: the only source of randomness in a run.
+  /// The run's random generator. Stages also seed generators of their own from fixed values
+  /// or hashes of what they sample (a grasp, a keyframe, an effort level), so that one check
+  /// gives the same answer whenever it is asked; no randomness comes from outside the run.
   std::mt19937_64& rng() { return rng_; }
   /// Accumulated seconds per stage.
   const StageTimes& stage_times() const { return times_; }

@@ -1,4 +1,5 @@
-// The milestone fill of the task planner (paper Alg. 2 with the counting heuristic): a lazy
+// The milestone fill of the task planner (paper Alg. 2; the heuristic is the variant's: WRAP's
+// backward abstraction, or counting for the "counting" variant and plan improvement): a lazy
 // weighted best-first search over the symbolic state of one assembly step, edges validated by
 // the KeyframeSolver only on the best candidate plan, effort levels for suspended edges and
 // widening of the grasp and placement subsets.

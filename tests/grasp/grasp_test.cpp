@@ -338,24 +338,31 @@ TEST(Preprocess, StopsWhenCancelledOrOutOfTime) {
   }
   {
     // Cancel while it samples a large grasp set: it must answer the stop (the bound only catches
-    // a hang; the latency itself depends on the machine's load and is not asserted).
-    std::stop_source stop;
-    RunContext ctx(0);
-    ctx.set_stop_token(stop.get_token());
-    PreprocessOptions o = Quick(2000);
-    Result<Preprocessed> r = Fail(ErrorCode::kInternal, "not run");
-    std::chrono::steady_clock::time_point done;
-    std::thread worker([&] {
-      r = Preprocess(s.project, s.check, o, ctx);
-      done = std::chrono::steady_clock::now();
-    });
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    const auto asked = std::chrono::steady_clock::now();
-    stop.request_stop();
-    worker.join();
-    if (r) GTEST_SKIP() << "finished before the cancel";
-    EXPECT_EQ(r.error().code, ErrorCode::kCancelled) << r.error().message;
-    EXPECT_LT(std::chrono::duration<double>(done - asked).count(), 5.0) << "a hang";
+    // a hang; the latency itself depends on the machine's load and is not asserted). A machine
+    // fast enough to finish before the stop is asked again sooner.
+    bool stopped_midway = false;
+    for (int delay_ms : {100, 20, 2}) {
+      std::stop_source stop;
+      RunContext ctx(0);
+      ctx.set_stop_token(stop.get_token());
+      PreprocessOptions o = Quick(2000);
+      Result<Preprocessed> r = Fail(ErrorCode::kInternal, "not run");
+      std::chrono::steady_clock::time_point done;
+      std::thread worker([&] {
+        r = Preprocess(s.project, s.check, o, ctx);
+        done = std::chrono::steady_clock::now();
+      });
+      std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+      const auto asked = std::chrono::steady_clock::now();
+      stop.request_stop();
+      worker.join();
+      if (r) continue;  // finished before the stop
+      EXPECT_EQ(r.error().code, ErrorCode::kCancelled) << r.error().message;
+      EXPECT_LT(std::chrono::duration<double>(done - asked).count(), 5.0) << "a hang";
+      stopped_midway = true;
+      break;
+    }
+    EXPECT_TRUE(stopped_midway) << "preprocessing finished within 2 ms every time: no stop tested";
   }
 }
 
@@ -395,7 +402,12 @@ class ExampleProjects : public ::testing::TestWithParam<std::string> {};
 TEST_P(ExampleProjects, PreprocessGivesPlacementsGraspsAndReachableSlots) {
   const fs::path file = fs::path(WRAP_SOURCE_DIR) / "projects" / (GetParam() + ".json");
   const LoadedProject lp = LoadProject(file);
-  if (!lp.ok()) GTEST_SKIP() << "project does not validate here (meshes missing?)";
+  // Only the Fabrica projects may be absent here (their meshes are in ../shared).
+  if (!lp.ok() && GetParam().starts_with("fabrica") &&
+      !fs::exists(fs::path(WRAP_SHARED_DIR) / "fabrica")) {
+    GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
+  }
+  ASSERT_TRUE(lp.ok()) << GetParam() << " does not validate";
   const Project& p = *lp.project;
   PreprocessOptions o;
   o.project_file = file;
@@ -485,7 +497,7 @@ INSTANTIATE_TEST_SUITE_P(Projects, ExampleProjects,
 TEST(Placements, StoolLegRestsOnItsEndsAndItsSide) {
   const fs::path file = fs::path(WRAP_SOURCE_DIR) / "projects" / "stool.json";
   const LoadedProject lp = LoadProject(file);
-  if (!lp.ok()) GTEST_SKIP() << "stool does not validate here";
+  ASSERT_TRUE(lp.ok()) << "stool does not validate";
   RunContext ctx(0);
   auto r = Preprocess(*lp.project, lp.check, Quick(), ctx);
   ASSERT_TRUE(r) << r.error().message;
