@@ -2,12 +2,15 @@
 // "folder" that is a regular file, a full disk, a file-size limit): the call fails with a message
 // naming the path, the previous file stays byte-for-byte intact and no temporary file is left.
 //
-// CI runs as root, where permission bits do not stop writes: the unwritable-folder case only runs
-// for other users, and the parent-is-a-file, disk-full (a character device like /dev/full) and
-// file-size-limit (RLIMIT_FSIZE, EFBIG) cases stand in for it everywhere.
+// CI runs as root, where permission bits do not stop writes: there the unwritable-folder case
+// saves from a child process that has dropped to the user 'nobody'. The parent-is-a-file,
+// disk-full (a character device like /dev/full) and file-size-limit (RLIMIT_FSIZE, EFBIG) cases
+// cover the other ways a write fails.
+#include <grp.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -103,17 +106,47 @@ TEST(FileSafety, SaveIntoAFolderThatIsARegularFile) {
   ExpectIntact(prev, dir.path);
 }
 
+// Saves `project` to `file` as another user than root (a forked child that drops to 'nobody',
+// uid and gid 65534), where permission bits apply; the child's exit code says how it went: 0
+// saved, 10 failed with kIo naming "Permission denied", 11 failed otherwise, 12 could not drop.
+int SaveAsNobody(const Project& project, const fs::path& file) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (::setgroups(0, nullptr) != 0 || ::setgid(65534) != 0 || ::setuid(65534) != 0) _exit(12);
+    auto saved = SaveProject(project, file);
+    if (saved) _exit(0);
+    const bool denied = saved.error().code == ErrorCode::kIo &&
+                        saved.error().message.find("Permission denied") != std::string::npos;
+    _exit(denied ? 10 : 11);
+  }
+  int status = 0;
+  if (pid < 0 || ::waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) return -1;
+  return WEXITSTATUS(status);
+}
+
 TEST(FileSafety, SaveIntoAnUnwritableFolder) {
-  if (::geteuid() == 0) GTEST_SKIP() << "root writes whatever the permission bits say";
   TempDir dir("unwritable");
   const Previous prev = SaveOriginal(dir.path);
-  fs::permissions(dir.path, fs::perms::owner_read | fs::perms::owner_exec);
-  auto saved = SaveProject(Edited(), prev.file);
-  fs::permissions(dir.path, fs::perms::owner_all);
-  ASSERT_FALSE(saved.has_value());
-  EXPECT_EQ(saved.error().code, ErrorCode::kIo);
-  EXPECT_NE(saved.error().message.find("Permission denied"), std::string::npos)
-      << saved.error().message;
+  // Readable and searchable by everyone (the child as 'nobody' reaches the file), writable by
+  // no one.
+  const auto rx = fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                  fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec;
+  fs::permissions(dir.path, rx);
+  if (::geteuid() == 0) {
+    // Root writes whatever the permission bits say: the save runs as 'nobody'.
+    const int code = SaveAsNobody(Edited(), prev.file);
+    fs::permissions(dir.path, fs::perms::owner_all);
+    ASSERT_NE(code, 12) << "could not drop to the user nobody";
+    EXPECT_EQ(code, 10) << "0: saved into a read-only folder; 11: failed without naming the "
+                           "permission; -1: the child died";
+  } else {
+    auto saved = SaveProject(Edited(), prev.file);
+    fs::permissions(dir.path, fs::perms::owner_all);
+    ASSERT_FALSE(saved.has_value());
+    EXPECT_EQ(saved.error().code, ErrorCode::kIo);
+    EXPECT_NE(saved.error().message.find("Permission denied"), std::string::npos)
+        << saved.error().message;
+  }
   ExpectIntact(prev, dir.path);
 }
 
