@@ -117,8 +117,10 @@ bool PlacePart(Project& project, const Subassembly& sub, int p, const Placed& ho
     }
     Iso3 X_WT = Iso3::Identity();
     X_WT.translation() = Vec3(pos.x(), pos.y(), t.height);
-    // Parts are modelled in place (X_AP = identity): the subassembly frame is the part frame.
-    project.parts[p].initial_pose = FromIsometry(X_WT * X_TA);
+    // The part's subassembly frame is the assembly frame: X_WP = X_WA * X_AP (X_AP is the
+    // identity for meshes modelled in place, a STEP instance's placement otherwise).
+    project.parts[p].initial_pose =
+        FromIsometry(X_WT * X_TA * ToIsometry(project.parts[p].assembled_pose));
     taken.push_back(box);
     char buf[96];
     std::snprintf(buf, sizeof buf, "(%.3f, %.3f) m, placement %d of %zu", pos.x(), pos.y(),
@@ -166,8 +168,10 @@ Result<LayoutReport> LayOutParts(Project& project, const ProjectCheck& check,
       if (std::find(todo.begin(), todo.end(), p) != todo.end()) continue;
       const Subassembly& sub = pre->subassemblies[p];
       Box2 b{Eigen::Vector2d::Constant(1e9), Eigen::Vector2d::Constant(-1e9)};
+      const Iso3 X_WA = ToIsometry(project.parts[p].initial_pose) *
+                        ToIsometry(project.parts[p].assembled_pose).inverse();
       for (const Vec3& v : sub.hull.mesh.vertices) {
-        const Vec3 w = ToIsometry(project.parts[p].initial_pose) * v;
+        const Vec3 w = X_WA * v;
         b.lo = b.lo.cwiseMin(w.head<2>());
         b.hi = b.hi.cwiseMax(w.head<2>());
       }

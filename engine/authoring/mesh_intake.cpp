@@ -8,6 +8,7 @@
 #include <set>
 
 #include "geometry/mesh_import.h"
+#include "geometry/step_import.h"
 
 namespace wrap {
 
@@ -84,6 +85,35 @@ double ScaleOf(LengthUnit unit) {
   }
 }
 
+// One part per leaf instance of a STEP assembly file, in the assembly frame.
+Result<MeshIntake> ReadStepAssembly(const fs::path& file, LengthUnit unit) {
+  auto assembly = ImportStep(file);
+  if (!assembly) return std::unexpected(assembly.error());
+  if (assembly->instances.size() < 2) {
+    return Fail(ErrorCode::kInvalidInput,
+                "'" + file.string() + "' holds " + std::to_string(assembly->instances.size()) +
+                    " part: an assembly needs at least two (a STEP assembly file, or one mesh "
+                    "file per part)");
+  }
+  MeshIntake out;
+  for (const StepInstance& inst : assembly->instances) {
+    const StepSolid& solid = assembly->solids[static_cast<size_t>(inst.solid)];
+    TriangleMesh mesh = solid.mesh;
+    for (Vec3& v : mesh.vertices) v = inst.X_AS * v;
+    out.names.push_back(inst.name);
+    out.files.push_back(file);
+    out.meshes.push_back(std::move(mesh));
+    out.solids.push_back(solid.name);
+    out.X_AP.push_back(inst.X_AS);
+    out.colors.push_back(inst.color);
+  }
+  out.unit = LengthUnit::kMetre;
+  out.scale = 1.0;
+  out.unit_reason = "the STEP file's own unit (" + assembly->unit + "), converted to metres" +
+                    (unit == LengthUnit::kAuto ? "" : "; --unit does not apply to STEP");
+  return out;
+}
+
 }  // namespace
 
 const char* ToString(LengthUnit unit) {
@@ -113,6 +143,9 @@ Result<MeshIntake> ReadAssemblyMeshes(const std::vector<fs::path>& inputs, Lengt
   auto files = ListFiles(inputs);
   if (!files) return std::unexpected(files.error());
   if (files->empty()) return Fail(ErrorCode::kInvalidInput, "no mesh files given");
+  if (files->size() == 1 && LooksLikeStep(files->front())) {
+    return ReadStepAssembly(files->front(), unit);
+  }
   if (files->size() == 1) {
     return Fail(ErrorCode::kInvalidInput,
                 "only one mesh ('" + files->front().string() +
@@ -142,6 +175,9 @@ Result<MeshIntake> ReadAssemblyMeshes(const std::vector<fs::path>& inputs, Lengt
     out.names.push_back(name);
     out.files.push_back(f);
     out.meshes.push_back(std::move(*mesh));
+    out.solids.emplace_back();
+    out.X_AP.push_back(Iso3::Identity());
+    out.colors.emplace_back();
   }
   out.unit = unit;
   if (unit == LengthUnit::kAuto) {

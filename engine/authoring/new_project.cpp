@@ -64,7 +64,10 @@ void AddParts(const MeshIntake& in, const fs::path& output, Project& p) {
     part.mesh = fs::absolute(in.files[i]).lexically_relative(dir).generic_string();
     if (part.mesh.empty()) part.mesh = fs::absolute(in.files[i]).generic_string();
     part.scale = in.scale;
+    part.solid = in.solids[i];
+    part.assembled_pose = FromIsometry(in.X_AP[i]);
     part.color = kPalette[i % std::size(kPalette)];
+    if (in.colors[i]) part.color = *in.colors[i];
     p.parts.push_back(std::move(part));
   }
 }
@@ -194,9 +197,12 @@ Result<NewProjectResult> NewProject(const std::vector<fs::path>& meshes, const f
 
   Project& p = out.project;
   p.name = options.name.empty() ? output.stem().string() : options.name;
-  p.description = "Made by wrap new from " + std::to_string(n) + " meshes (" +
-                  ToString(intake->unit) + "): the DAG by assembly-by-disassembly, initial poses " +
-                  "from stable placements a robot can pick.";
+  const bool step = !intake->solids.front().empty();
+  p.description = "Made by wrap new from " +
+                  (step ? std::to_string(n) + " parts of " + intake->files.front().filename().string()
+                        : std::to_string(n) + " meshes (" + ToString(intake->unit) + ")") +
+                  ": the DAG by assembly-by-disassembly, initial poses from stable placements a "
+                  "robot can pick.";
   p.table = TableFor(options.robot_model);
   p.planner.grasps = options.grasps;
   AddParts(*intake, output, p);

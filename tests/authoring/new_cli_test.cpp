@@ -8,6 +8,8 @@
 
 #include "../app/cli_runner.h"
 #include "geometry/mesh_export.h"
+#include "geometry/step_import.h"
+#include "model/project_io.h"
 #include "model/validate.h"
 
 namespace wrap::cli {
@@ -98,6 +100,56 @@ TEST_P(NewFromMeshes, ValidatesAndPlans) {
   const CliRun plan = Wrap({"plan", out.string(), "--task-only", "--validate", "--seed", "0"});
   EXPECT_EQ(plan.code, 0) << made.out << plan.out << plan.err;
   EXPECT_NE(plan.out.find("Validated:"), std::string::npos) << plan.out;
+}
+
+// From one STEP assembly file (the shipped stool: a seat and four instances of one leg, in
+// millimetres): one part per instance, named after it, sharing the leg's solid, placed where the
+// file places it; each rests on the table (validation warns of a floating part), and the project
+// plans with motion and validates.
+TEST(NewCli, FromAStepAssemblyFile) {
+  if (!StepImportAvailable()) GTEST_SKIP() << "built without OpenCASCADE (WRAP_WITH_OCCT=OFF)";
+  const fs::path step = fs::path(WRAP_SOURCE_DIR) / "assets" / "parts" / "step" / "stool.step";
+  const fs::path out = TempDir("from_step") / "stool_new.json";
+  const CliRun made = Wrap({"new", step.string(), "-o", out.string()});
+  ASSERT_EQ(made.code, 0) << made.out << made.err;
+  EXPECT_NE(made.out.find("the STEP file's own unit (millimetre)"), std::string::npos) << made.out;
+  const CliRun v = Wrap({"validate", out.string()});
+  EXPECT_EQ(v.code, 0) << v.err;
+  EXPECT_NE(v.out.find(", 0 warning(s)"), std::string::npos) << v.out << v.err;
+
+  const LoadedProject lp = LoadProject(out);
+  ASSERT_TRUE(lp.ok());
+  const wrap::Project& p = *lp.project;
+  ASSERT_EQ(p.parts.size(), 5u);
+  int legs = 0;
+  for (const Part& part : p.parts) {
+    EXPECT_EQ(fs::path(part.mesh).filename(), "stool.step") << part.name;
+    EXPECT_EQ(part.scale, 1.0) << part.name;
+    if (part.solid == "leg") {
+      ++legs;
+      // The legs stand at the seat's corners: placed by the file, not at the origin.
+      EXPECT_GT(part.assembled_pose.xyz.head<2>().norm(), 0.05) << part.name;
+    }
+  }
+  EXPECT_EQ(legs, 4);
+  EXPECT_EQ(p.steps.size(), 4u);
+
+  const CliRun plan = Wrap({"plan", out.string(), "--validate", "--seed", "0"});
+  EXPECT_EQ(plan.code, 0) << made.out << plan.out << plan.err;
+  EXPECT_NE(plan.out.find("Trajectories checked:"), std::string::npos) << plan.out;
+}
+
+// A STEP file with a single part is not an assembly: exit 2 saying so, nothing written.
+TEST(NewCli, AStepFileWithOnePartIsRefused) {
+  if (!StepImportAvailable()) GTEST_SKIP() << "built without OpenCASCADE (WRAP_WITH_OCCT=OFF)";
+  const fs::path step = fs::path(WRAP_SOURCE_DIR) / "tests" / "fuzz" / "seeds" / "step" /
+                        "box_mm.step";
+  const fs::path out = TempDir("from_step_one") / "p.json";
+  const CliRun r = Wrap({"new", step.string(), "-o", out.string()});
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("box_mm.step"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("an assembly needs at least two"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 INSTANTIATE_TEST_SUITE_P(Examples, NewFromMeshes,
