@@ -127,8 +127,14 @@ StepGeometry CheckStep(const Project& project, const AssemblyTree& tree, Assembl
   return sg;
 }
 
+// The steps can be judged: the DAG is sound and every part's mesh was read (a missing mesh is
+// already an error; without it every step holding the part would also "not touch").
 bool StepsUsable(const Project& project, const ProjectCheck& check) {
   if (!check.tree) return false;
+  if (check.parts.size() != project.parts.size()) return false;
+  for (const PartGeometry& part : check.parts) {
+    if (!part.loaded) return false;
+  }
   for (const Step& step : project.steps) {
     if (check.tree->Find(step.mating.moved) < 0 || check.tree->Find(step.mating.base) < 0) {
       return false;

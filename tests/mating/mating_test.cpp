@@ -256,6 +256,20 @@ TEST(GeometryCheck, InputsThatDoNotTouchAreAnError) {
   EXPECT_NE(d.message.find("'c' touches no other part"), std::string::npos) << d.message;
 }
 
+// A part whose mesh was not read (validation has said so) makes no step look wrong: the steps
+// are not judged until every mesh is there.
+TEST(GeometryCheck, AMissingMeshIsNotReportedAgainAsStepsThatDoNotTouch) {
+  Scene s;
+  s.Add("a", BoxMesh(Mm(0, 0, 0), Mm(10, 10, 10)));
+  s.Add("b", BoxMesh(Mm(10, 0, 0), Mm(20, 10, 10)));
+  SceneProject p(s, {MakeStep("ab", "b", "a", Vec3::UnitX())});
+  ASSERT_TRUE(p.check.tree);
+  p.check.parts[1] = PartGeometry{};  // its file was not found
+  const GeometryReport r = CheckAssemblyGeometry(p.project, p.check, "p.json");
+  EXPECT_EQ(r.diagnostics.error_count(), 0);
+  EXPECT_TRUE(r.steps.empty());
+}
+
 TEST(GeometryCheck, OverlappingStartIsAnErrorNamingBothParts) {
   Scene s;
   s.Add("a", BoxMesh(Mm(0, 0, 0), Mm(10, 10, 10)));
