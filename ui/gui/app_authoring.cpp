@@ -46,6 +46,8 @@ bool TakeAuthoring(AppState& app) {
       log.error = done.error().message;
     } else {
       log.lines = DescribeChanges(before, app.doc.project());
+      // A new assembly: look at the whole cell again (the old view framed other parts).
+      if (outcome->kind == AuthoringKind::kImportAssembly) app.frame_next_cell = true;
     }
   }
   char secs[32];

@@ -47,6 +47,8 @@ void App::UpdateViewport() {
       } else {
         built_key_ = std::move(key);
         built_file_ = s_.doc.ResolvePath();
+        if (s_.frame_next_cell) s_.viewport.ResetCamera();
+        s_.frame_next_cell = false;
       }
       plan_states_.clear();
     }

@@ -134,6 +134,9 @@ struct AppState {
     std::string error;               ///< Why nothing was applied ("" when applied).
   } authoring_log;
   bool show_authoring_log = false;  ///< The "Changes" window is open.
+  /// The next rebuilt cell is framed anew (after an edit that replaces what is on the table,
+  /// e.g. Import assembly); otherwise a rebuild keeps the user's camera.
+  bool frame_next_cell = false;
   FrameStats frames;                       ///< Recent frame times.
 
   /// True when a plan is on show and the document has changed since it was made (a plan for
