@@ -1,6 +1,9 @@
 #include "cli.h"
 
 #include <CLI/CLI.hpp>
+
+#include "core/log.h"
+#include "load.h"
 #include <cstdint>
 #include <ostream>
 
@@ -113,6 +116,12 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       ->check(CLI::PositiveNumber);
   plan->add_flag("--validate", plan_args.validate,
                  "Replay the plan with the independent validator; exit 1 if it fails");
+  plan->add_flag("--no-keyframe-opt", plan_args.no_keyframe_opt,
+                 "Skip the joint keyframe optimisation (the task plan's keyframes go to motion "
+                 "as planned; the plan changes)");
+  plan->add_option("--dump-refused", plan_args.dump_refused,
+                   "Debugging: save every timed result the planner's own trajectory check "
+                   "refuses into this folder (refused_N.json)");
   plan->add_flag("--task-only", plan_args.task_only,
                  "Stop after the task plan: no keyframe optimisation, motion planning or "
                  "retiming");
@@ -219,6 +228,15 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
                  "GUI: run this file of UI commands (select, set, add-edge, run, scrub, save, "
                  "...) and exit");
 
+  // The log: every subcommand that plans or simulates takes --log (or WRAP_LOG).
+  std::string log_spec;
+  std::string log_help = "Log these topics to stderr, comma-separated, each optionally :trace "
+                         "(also from WRAP_LOG): all";
+  for (const LogTopic& t : KnownLogTopics()) log_help += ", " + std::string(t.name);
+  for (CLI::App* a : {preprocess, plan, sim}) {
+    a->add_option("--log", log_spec, log_help)->envname("WRAP_LOG");
+  }
+
   // CLI11 takes arguments in reverse order.
   std::vector<std::string> reversed(args.rbegin(), args.rend());
   try {
@@ -228,6 +246,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     const int code = app.exit(e, out, err);
     return code == 0 ? 0 : 2;
   }
+  if (!SetLogTopics(log_spec, err)) return 2;
   if (validate->parsed()) return Validate(project, validate_plan, quiet, out, err);
   if (info->parsed()) return Info(project, out, err);
   if (preprocess->parsed()) {

@@ -97,6 +97,8 @@ struct PlanArgs {
   int grasps = 0;                     ///< --grasps; 0: the project's planner.grasps.
   bool validate = false;              ///< --validate with the independent validator.
   bool task_only = false;             ///< --task-only.
+  bool no_keyframe_opt = false;       ///< --no-keyframe-opt.
+  std::string dump_refused;           ///< --dump-refused DIR; empty: none.
 };
 
 /// `wrap plan PROJECT [-o PLAN.json] ...`: preprocesses, plans, prints the actions in words and

@@ -116,6 +116,7 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   const double time_limit = args.time_limit.value_or(p.planner.time_limit_s);
   RunContext ctx(seed);
   ctx.set_time_limit_s(time_limit);
+  UseLog(ctx, err);
 
   out << "Planning '" << p.name << "' (" << options.planner << ", seed " << seed << ", wrench "
       << args.wrench << ", lambda " << Fmt("%g", options.force_scale) << ", time limit "
@@ -139,6 +140,8 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   pipeline.task_only = args.task_only;
   pipeline.seed = seed;
   pipeline.budget = args.budget;
+  pipeline.optimize_keyframes = !args.no_keyframe_opt;
+  pipeline.motion.dump_refused_dir = args.dump_refused;
   const auto t_plan = std::chrono::steady_clock::now();
   auto plan = PlanAssembly(p, loaded.check, *pre, pipeline, ctx);
   const double t_planning =

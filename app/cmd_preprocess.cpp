@@ -47,6 +47,7 @@ int Preprocess(const PreprocessArgs& args, std::ostream& out, std::ostream& err)
   options.grasps = args.grasps;
   if (args.slots >= 0) options.table_slots.num_slots = args.slots;
   RunContext ctx(args.seed.value_or(p.planner.seed));
+  UseLog(ctx, err);
   auto result = wrap::Preprocess(p, loaded.check, options, ctx);
   if (!result) {
     err << args.project << ": " << result.error().message << "\n";

@@ -68,6 +68,7 @@ int Sim(const SimArgs& args, std::ostream& out, std::ostream& err) {
     };
   }
   RunContext ctx;
+  UseLog(ctx, err);
   auto report = SimulatePlan(*loaded.project, loaded.check, args.project, *plan, options, ctx);
   if (!report) {
     Error e = report.error();

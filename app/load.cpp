@@ -53,6 +53,27 @@ std::vector<PlanContact> ToPlanContacts(const ContactGraph& graph) {
   return out;
 }
 
+namespace {
+LogTopics& ProcessLogTopics() {
+  static LogTopics topics;
+  return topics;
+}
+}  // namespace
+
+bool SetLogTopics(const std::string& spec, std::ostream& err) {
+  auto topics = LogTopics::Parse(spec);
+  if (!topics) {
+    err << "--log (or WRAP_LOG): " << topics.error().message << "\n";
+    return false;
+  }
+  ProcessLogTopics() = std::move(*topics);
+  return true;
+}
+
+void UseLog(RunContext& ctx, std::ostream& err) {
+  if (!ProcessLogTopics().empty()) ctx.set_log(StreamLogSink(err), ProcessLogTopics());
+}
+
 std::string Fmt(const char* format, double value) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, value);

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "core/run_context.h"
 #include "mating/check.h"
 #include "model/validate.h"
 #include "task/plan.h"
@@ -24,6 +25,13 @@ bool ReportLoad(const LoadedProject& loaded, const std::string& project, std::os
 
 /// The contact graph as the plan records it.
 std::vector<PlanContact> ToPlanContacts(const ContactGraph& graph);
+
+/// The log topics of this process (`--log` or WRAP_LOG), set once after the arguments are
+/// parsed; false (and a message in `err`) when `spec` names an unknown topic or level.
+bool SetLogTopics(const std::string& spec, std::ostream& err);
+
+/// Sends `ctx`'s log to `err`, for the topics set by SetLogTopics (none: nothing logged).
+void UseLog(RunContext& ctx, std::ostream& err);
 
 /// printf-style formatting of one number, e.g. Fmt("%.2f", 1.5).
 std::string Fmt(const char* format, double value);

@@ -9,6 +9,9 @@
 #include <random>
 #include <stop_token>
 #include <string>
+#include <string_view>
+
+#include "core/log.h"
 
 namespace wrap {
 
@@ -20,8 +23,8 @@ double ThreadCpuSeconds();
 /// Per-stage wall-clock totals [s], keyed by stage name (e.g. "grasp", "fwd_search").
 using StageTimes = std::map<std::string, double>;
 
-/// Cancellation, deadline, progress, randomness and timing for one planner run. A run owns one
-/// context; stages check `ShouldStop()` in every loop that can take longer than ~50 ms.
+/// Cancellation, deadline, progress, randomness, timing and the log for one planner run. A run
+/// owns one context; stages check `ShouldStop()` in every loop that can take longer than ~50 ms.
 class RunContext {
  public:
   using Clock = std::chrono::steady_clock;
@@ -39,6 +42,13 @@ class RunContext {
   void set_time_limit_s(double seconds);
   /// Receives progress reports.
   void set_progress(ProgressFn fn) { progress_ = std::move(fn); }
+  /// Sends the lines of `topics` to `sink` (none by default).
+  void set_log(LogSink sink, LogTopics topics) {
+    log_ = std::move(sink);
+    log_topics_ = std::move(topics);
+  }
+  /// The same log as `other`'s (a sub-run of it).
+  void set_log_from(const RunContext& other) { set_log(other.log_, other.log_topics_); }
 
   /// The stop token (for a sub-run that must stop with this one).
   const std::stop_token& stop_token() const { return stop_; }
@@ -50,6 +60,16 @@ class RunContext {
   bool timed_out() const { return Clock::now() >= deadline_; }
   /// True when the run must stop now (cancelled or past its deadline).
   bool ShouldStop() const { return cancelled() || timed_out(); }
+  /// True when lines of `topic` at `level` are logged (check it before building an expensive
+  /// line).
+  bool Logs(std::string_view topic, LogLevel level = LogLevel::kDebug) const {
+    return log_ && log_topics_.Enabled(topic, level);
+  }
+  /// Logs `text` under `topic` at `level`, if that is logged.
+  void Log(std::string_view topic, const std::string& text,
+           LogLevel level = LogLevel::kDebug) const {
+    if (Logs(topic, level)) log_(topic, level, text);
+  }
   /// The progress sink (empty when none), for a sub-run that reports through this one.
   const ProgressFn& progress_fn() const { return progress_; }
   /// Reports progress to the sink, if any.
@@ -69,6 +89,8 @@ class RunContext {
   std::stop_token stop_;
   Clock::time_point deadline_ = Clock::time_point::max();
   ProgressFn progress_;
+  LogSink log_;
+  LogTopics log_topics_;
   std::mt19937_64 rng_;
   StageTimes times_;
 };

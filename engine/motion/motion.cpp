@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <atomic>
 #include <filesystem>
 
 #include "motion/retime.h"
@@ -102,7 +103,7 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
     plan.actions = std::move(work.actions);
     ctx.Progress("retime", -1.0,
                  std::to_string(segments->size()) + " segments timed into per-robot trajectories");
-    auto timing = Retime(world, plan, *segments);
+    auto timing = Retime(world, plan, *segments, &ctx);
     // Where an object carried by one robot would load its gripper beyond kMaxLoad with its
     // weight and inertia, that segment runs slower (the inertial part falls with the square of
     // the time stretch), and the schedule is made again.
@@ -124,19 +125,19 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
         double k = 1.0;
         while (f * k < kMaxSlow && load.Peak(1.0 / (k * k)) > target) k *= 1.1;
         k = std::min(k, kMaxSlow / f);
-        if (std::getenv("WRAP_MOTION_DEBUG")) {
-          std::fprintf(
-              stderr,
-              "[load] segment %zu (%s, action %d): peak %.2f (weight %.2f), %.2f x slower: %.2f\n",
-              j, std::string(ToString(g.kind)).c_str(), g.action + 1, peak, load.Peak(0.0), f * k,
-              load.Peak(1.0 / (k * k)));
+        if (ctx.Logs("motion")) {
+          ctx.Log("motion",
+                  StrFormat("load: segment %zu (%s, action %d): peak %.2f (weight %.2f), %.2f x "
+                            "slower: %.2f",
+                            j, std::string(ToString(g.kind)).c_str(), g.action + 1, peak,
+                            load.Peak(0.0), f * k, load.Peak(1.0 / (k * k))));
         }
         if (k <= 1.0 + 1e-9) continue;
         g.slow = f * k;
         slowed = true;
       }
       if (!slowed) break;
-      timing = Retime(world, plan, *segments);
+      timing = Retime(world, plan, *segments, &ctx);
     }
     const double t_retime = Since(t0);
     out.t_retime_s += t_retime;
@@ -155,7 +156,9 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
     if (!options.self_check) break;
     t0 = std::chrono::steady_clock::now();
     ctx.Progress("check", -1.0, "the timed trajectories, densely");
-    auto check = CheckTrajectories(world, plan, TrajectoryCheckOptions{});
+    TrajectoryCheckOptions check_options;
+    check_options.log = &ctx;
+    auto check = CheckTrajectories(world, plan, check_options);
     out.t_mp_s += Since(t0);
     if (!check) return std::unexpected(check.error());
     if (check->valid) break;
@@ -179,15 +182,15 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
         redo.push_back(g.free_index);
       }
     }
-    if (std::getenv("WRAP_MOTION_DEBUG")) {
-      std::fprintf(stderr, "[timed] %s%s\n", FormatTrajectoryIssue(plan, issue).c_str(),
-                   redo.empty() ? "" : " (its free paths are searched again)");
+    if (ctx.Logs("motion")) {
+      ctx.Log("motion", "timed: " + FormatTrajectoryIssue(plan, issue) +
+                            (redo.empty() ? "" : " (its free paths are searched again)"));
     }
-    if (const char* dump = std::getenv("WRAP_MOTION_DUMP")) {
+    if (!options.dump_refused_dir.empty()) {
       // Debugging: keep every refused timed result (a folder; one file per refusal).
-      static int dumped = 0;
-      (void)SavePlan(
-          plan, std::filesystem::path(dump) / ("refused_" + std::to_string(dumped++) + ".json"));
+      static std::atomic<int> dumped = 0;
+      (void)SavePlan(plan, options.dump_refused_dir /
+                               ("refused_" + std::to_string(dumped++) + ".json"));
     }
     plan.trajectories.clear();
     plan.segments.clear();

@@ -142,7 +142,7 @@ TimedSegment TimeSegment(const TaskWorld& world, const GeoSegment& seg) {
 }  // namespace
 
 Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
-                      const std::vector<GeoSegment>& segments) {
+                      const std::vector<GeoSegment>& segments, const RunContext* log) {
   const int n_robots = static_cast<int>(world.robots.size());
   const int n_seg = static_cast<int>(segments.size());
   for (const GeoSegment& s : segments) {
@@ -184,13 +184,13 @@ Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
         ++out.dependencies;
       }
     }
-    if (std::getenv("WRAP_MOTION_DEBUG")) {
-      std::fprintf(stderr, "[sched] %d %s a%d waits for %d (%s)\n", j,
-                   std::string(ToString(s.kind)).c_str(), s.action + 1, binding,
-                   binding < 0 ? "-"
-                               : (dep[binding] == 1   ? "robot"
-                                  : dep[binding] == 2 ? "object"
-                                                      : "sweep"));
+    if (log && log->Logs("motion")) {
+      log->Log("motion", StrFormat("schedule: %d %s a%d waits for %d (%s)", j,
+                                   std::string(ToString(s.kind)).c_str(), s.action + 1, binding,
+                                   binding < 0                ? "-"
+                                   : dep[binding] == 1 ? "robot"
+                                   : dep[binding] == 2 ? "object"
+                                                       : "sweep"));
     }
     start[j] = t;
     end[j] = t + timed[j].duration;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/result.h"
+#include "core/run_context.h"
 #include "motion/segments.h"
 #include "task/plan.h"
 #include "task/world.h"
@@ -32,9 +33,10 @@ struct Timing {
   int dependencies = 0;                ///< Ordering constraints the schedule kept.
 };
 
-/// Times the geometric motion `segments` of `plan` (from PlanGeometricMotion). Fails with
-/// kInvalidInput when a segment's robots or waypoints do not fit the world.
+/// Times the geometric motion `segments` of `plan` (from PlanGeometricMotion); `log` (may be
+/// null) gets, under "motion", what each segment waits for. Fails with kInvalidInput when a
+/// segment's robots or waypoints do not fit the world.
 Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
-                      const std::vector<GeoSegment>& segments);
+                      const std::vector<GeoSegment>& segments, const RunContext* log = nullptr);
 
 }  // namespace wrap

@@ -415,18 +415,18 @@ std::vector<std::vector<JointVector>> Builder::Track(
         req.reference = goals ? JointVector(q0[i] + s * ((*goals)[i] - q0[i])) : q;
         auto sol = SolveNumericIk(r.chain, req, rng_, ik);
         if (!sol) {
-          if (std::getenv("WRAP_MOTION_DEBUG")) {
-            std::fprintf(stderr, "[track] %s step %d/%d: %s\n", r.name.c_str(), k, steps,
-                         sol.error().message.c_str());
+          if (ctx_.Logs("motion")) {
+            ctx_.Log("motion", StrFormat("track: %s step %d/%d: %s", r.name.c_str(), k, steps,
+                         sol.error().message.c_str()));
           }
           return {};
         }
         next = sol->q;
       }
       if ((next - q).cwiseAbs().maxCoeff() > kMaxTrackJump) {
-        if (std::getenv("WRAP_MOTION_DEBUG")) {
-          std::fprintf(stderr, "[track] %s step %d/%d: jump %.3f\n", r.name.c_str(), k, steps,
-                       (next - q).cwiseAbs().maxCoeff());
+        if (ctx_.Logs("motion")) {
+          ctx_.Log("motion", StrFormat("track: %s step %d/%d: jump %.3f", r.name.c_str(), k, steps,
+                       (next - q).cwiseAbs().maxCoeff()));
         }
         return {};
       }
@@ -679,8 +679,8 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
       }
     }
     if (same) {
-      if (std::getenv("WRAP_MOTION_DEBUG")) {
-        std::fprintf(stderr, "[free] action %d: reused path %d\n", action + 1, index);
+      if (ctx_.Logs("motion")) {
+        ctx_.Log("motion", StrFormat("free: action %d: reused path %d", action + 1, index));
       }
       if (reached) *reached = end;
       seg.robots = c.robots;
@@ -742,11 +742,9 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
                                          LoadRatio(load, to[i])}) +
                                    1e-9});
     }
-    if (std::getenv("WRAP_MOTION_DEBUG")) {
-      for (size_t l = 0; l < loads.size(); ++l) {
-        std::fprintf(stderr, "[load] action %d %s: up to %.2f of its limits\n", action + 1,
-                     Name(loads[l].robot).c_str(), load_bound[l].second);
-      }
+    for (size_t l = 0; l < loads.size() && ctx_.Logs("motion"); ++l) {
+      ctx_.Log("motion", StrFormat("load: action %d %s: up to %.2f of its limits", action + 1,
+                                   Name(loads[l].robot).c_str(), load_bound[l].second));
     }
     query.valid = [&](const Eigen::VectorXd& x) {
       const std::vector<JointVector> qs = split(x);
@@ -768,7 +766,7 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
     query.final_resolution = query.resolution / kRefine;
     const PathAnswer answer = PlanPath(query);
     std::string hit;
-    if (std::getenv("WRAP_MOTION_DEBUG") && !answer.solved && !answer.timed_out) {
+    if (ctx_.Logs("motion") && !answer.solved && !answer.timed_out) {
       const bool at_start = answer.why.find("start") != std::string::npos;
       for (size_t i = 0; i < who.size(); ++i)
         scene_.SetRobot(who[i], at_start ? cur_[who[i]] : to[i]);
@@ -776,25 +774,23 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
       if (scene_.cell().InCollision(&res)) hit = " (" + scene_.cell().Describe(res.first) + ")";
       if (at_start) {
         for (int r : who) {
-          std::fprintf(stderr,
-                       "[free] start of %s: opening %.4f, holds %d; keyframes:", Name(r).c_str(),
-                       opening_[r], state_.held[r]);
+          std::string line = StrFormat("free: start of %s: opening %.4f, holds %d; keyframes:",
+                                       Name(r).c_str(), opening_[r], state_.held[r]);
           for (int j = std::max(0, action - 3); j <= action; ++j) {
-            std::fprintf(stderr, " %d:%s", j + 1,
-                         Same(plan_.actions[j].keyframe.q[r], cur_[r]) ? "same" : "differs");
+            line += StrFormat(" %d:%s", j + 1,
+                              Same(plan_.actions[j].keyframe.q[r], cur_[r]) ? "same" : "differs");
           }
-          std::fprintf(stderr, "\n");
+          ctx_.Log("motion", line);
         }
       }
     }
     for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], cur_[who[i]]);
-    if (std::getenv("WRAP_MOTION_DEBUG")) {
-      std::fprintf(
-          stderr, "[free] action %d robots %zu: %s%s, %lld checks, %.2f s, %zu waypoints\n",
+    if (ctx_.Logs("motion")) {
+      ctx_.Log("motion", StrFormat("free: action %d robots %zu: %s%s, %lld checks, %.2f s, %zu waypoints",
           action + 1, who.size(), answer.solved ? "solved" : answer.why.c_str(), hit.c_str(),
           answer.checks,
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t_query).count(),
-          answer.path.size());
+          answer.path.size()));
     }
     if (answer.solved) {
       for (const Eigen::VectorXd& x : answer.path) path->push_back(split(x));
@@ -804,7 +800,7 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
   std::vector<std::vector<JointVector>> path;
   PathAnswer answer = plan(movers, targets, &path);
   if (answer.solved && reached) *reached = answer.goal_index;
-  if (!answer.solved && answer.timed_out && std::getenv("WRAP_MOTION_DIAG") && movers.size() == 1) {
+  if (!answer.solved && answer.timed_out && ctx_.Logs("motion.diag") && movers.size() == 1) {
     // Diagnosis: is the start or the goal cut off from the robot's home?
     const JointVector saved = cur_[movers[0]];
     std::vector<std::vector<JointVector>> p1, p2;
@@ -833,10 +829,11 @@ bool Builder::Free(int action, bool main, const std::vector<int>& robots,
     }
     std::string near;
     for (const auto& [k, v] : hits) near += " " + k + " x" + std::to_string(v);
-    std::fprintf(stderr, "[diag] action %d %s (%s, holds %d): start->home %s, goal->home %s;%s\n",
+    ctx_.Log("motion.diag",
+             StrFormat("action %d %s (%s, holds %d): start->home %s, goal->home %s;%s",
                  action + 1, Name(movers[0]).c_str(), main ? "main" : "return",
                  state_.held[movers[0]], a1.solved ? "yes" : a1.why.c_str(),
-                 a2.solved ? "yes" : a2.why.c_str(), near.c_str());
+                 a2.solved ? "yes" : a2.why.c_str(), near.c_str()));
   }
   std::vector<int> who = movers;
   if (!answer.solved && answer.timed_out && effort_ > 0 && !ctx_.ShouldStop()) {
@@ -1139,11 +1136,11 @@ std::vector<std::vector<JointVector>> Builder::CarrySearch(
       }
     }
   }
-  if (std::getenv("WRAP_MOTION_DEBUG")) {
-    std::fprintf(stderr, "[carry] search: %zu poses, %d edges tried, %.2f s, %s\n", tree.size(),
+  if (ctx_.Logs("motion")) {
+    ctx_.Log("motion", StrFormat("carry: search: %zu poses, %d edges tried, %.2f s, %s", tree.size(),
                  edges,
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                 goal_node >= 0 ? "reached" : "not reached");
+                 goal_node >= 0 ? "reached" : "not reached"));
   }
   if (goal_node < 0) {
     why = "the goal pose was not reached from " + std::to_string(tree.size()) + " poses" +
@@ -1195,8 +1192,8 @@ bool Builder::KeyframeAccepts(int robot, const JointVector& q, const Keyframe& k
   if (!scene_.Set(at, opening_, qs, mating)) return false;
   CollisionResult hit;
   if (scene_.cell().InCollision(&hit)) {
-    if (std::getenv("WRAP_MOTION_DEBUG")) {
-      std::fprintf(stderr, "[keyframe] %s\n", scene_.cell().Describe(hit.first).c_str());
+    if (ctx_.Logs("motion")) {
+      ctx_.Log("motion", StrFormat("keyframe: %s", scene_.cell().Describe(hit.first).c_str()));
     }
     return false;
   }
@@ -1255,12 +1252,12 @@ void Builder::SlideStart(int action, Keyframe& goal) {
     }
     if (!KeyframeAccepts(h0, pre.q[h0], pre, {})) continue;
     if (!Tight(h0, pre.q[h0])) {
-      if (std::getenv("WRAP_MOTION_DEBUG")) {
-        std::fprintf(stderr,
-                     "[slide] action %d: %s %s %s at the approach; the slide starts %.0f mm "
-                     "further back\n",
-                     action + 1, NodeName(m_node).c_str(), clear ? "is close to" : "touches",
-                     NodeName(b_node).c_str(), 1000.0 * extra);
+      if (ctx_.Logs("motion")) {
+        ctx_.Log("motion",
+                 StrFormat("slide: action %d: %s %s %s at the approach; the slide starts %.0f mm "
+                           "further back",
+                           action + 1, NodeName(m_node).c_str(), clear ? "is close to" : "touches",
+                           NodeName(b_node).c_str(), 1000.0 * extra));
       }
       goal = std::move(pre);
       return;
@@ -1271,12 +1268,12 @@ void Builder::SlideStart(int action, Keyframe& goal) {
     }
   }
   if (first_clear) {
-    if (std::getenv("WRAP_MOTION_DEBUG")) {
-      std::fprintf(stderr,
-                   "[slide] action %d: %s touches %s at the approach; the slide starts %.0f mm "
-                   "further back (still tight)\n",
-                   action + 1, NodeName(m_node).c_str(), NodeName(b_node).c_str(),
-                   1000.0 * first_extra);
+    if (ctx_.Logs("motion")) {
+      ctx_.Log("motion",
+               StrFormat("slide: action %d: %s touches %s at the approach; the slide starts "
+                         "%.0f mm further back (still tight)",
+                         action + 1, NodeName(m_node).c_str(), NodeName(b_node).c_str(),
+                         1000.0 * first_extra));
     }
     goal = std::move(*first_clear);
   }
@@ -1339,11 +1336,11 @@ bool Builder::HoverAbove(int action, Keyframe& goal, std::vector<int>& holders,
         why = last_hit_;
         continue;
       }
-      if (std::getenv("WRAP_MOTION_DEBUG")) {
-        std::fprintf(stderr,
-                     "[hover] action %d: %s touches the table at the insertion's start; it is "
-                     "lowered %.0f mm onto it\n",
-                     action + 1, NodeName(m_node).c_str(), 1000.0 * d);
+      if (ctx_.Logs("motion")) {
+        ctx_.Log("motion",
+                 StrFormat("hover: action %d: %s touches the table at the insertion's start; it "
+                           "is lowered %.0f mm onto it",
+                           action + 1, NodeName(m_node).c_str(), 1000.0 * d));
       }
       descent.assign(path.rbegin(), path.rend());
       *length = len;
@@ -1491,9 +1488,9 @@ bool Builder::Action(int i) {
         }
         if (StageAccepts(r, i, false, K.q[r], q)) options.push_back(q);
       }
-      if (std::getenv("WRAP_MOTION_DEBUG")) {
-        std::fprintf(stderr, "[alternatives] action %d %s: %d IK solutions, %zu fit\n", i + 1,
-                     Name(r).c_str(), sols.count, options.size() - 1);
+      if (ctx_.Logs("motion")) {
+        ctx_.Log("motion", StrFormat("alternatives: action %d %s: %d IK solutions, %zu fit", i + 1,
+                     Name(r).c_str(), sols.count, options.size() - 1));
       }
     }
     for (size_t o = 0; o < options.size(); ++o) {

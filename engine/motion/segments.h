@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <string>
@@ -58,6 +59,9 @@ struct MotionOptions {
   /// Run the independent trajectory check on the timed result; a plan that fails it has no
   /// motion (its first issue is the failure), so no colliding trajectory leaves the planner.
   bool self_check = true;
+  /// Debugging: every timed result the self-check refuses is saved here as a plan JSON
+  /// (refused_N.json); empty: none (`wrap plan --dump-refused DIR`).
+  std::filesystem::path dump_refused_dir;
 };
 
 /// A segment of the geometric motion.

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/result.h"
+#include "core/run_context.h"
 #include "task/plan.h"
 #include "task/world.h"
 
@@ -28,6 +29,8 @@ struct TrajectoryCheckOptions {
   /// An object may touch the table top from above within this [m].
   double table_tolerance_m = 2e-3;
   bool check_collisions = true;  ///< Run the dense collision check (the expensive part).
+  /// Gets, under "motion", the objects' state at each collision found (null: nowhere).
+  const RunContext* log = nullptr;
 };
 
 /// One thing wrong with the trajectories.

@@ -113,7 +113,7 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
   first->stats.seed = seed;
 
   auto enqueue = [&](Plan plan) -> Result<void> {
-    if (options.optimize_keyframes && !std::getenv("WRAP_NO_KFOPT")) {
+    if (options.optimize_keyframes) {
       ctx.Progress("keyframes", -1.0,
                    "optimising the joint keyframes of task plan " + std::to_string(made) + " (" +
                        std::to_string(plan.actions.size()) + " actions)");
@@ -158,6 +158,7 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
       RunContext sub(seed + 7919ULL * static_cast<std::uint64_t>(made));
       sub.set_deadline(ctx.deadline());
       sub.set_stop_token(ctx.stop_token());
+      sub.set_log_from(ctx);
       ++made;
       sub.set_progress(
           [&ctx, n = made](const std::string& stage, double fraction, const std::string& message) {
@@ -214,9 +215,9 @@ Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
     ctx.Progress("motion", -1.0,
                  (f.suspend && c.effort < motion.max_effort ? "suspended: " : "failed: ") +
                      last_failure);
-    if (std::getenv("WRAP_MOTION_DEBUG")) {
-      std::fprintf(stderr, "[motion] plan %d effort %d: %s%s\n", c.order, c.effort,
-                   last_failure.c_str(), f.suspend ? " (suspended)" : "");
+    if (ctx.Logs("motion")) {
+      ctx.Log("motion", StrFormat("plan %d effort %d: %s%s", c.order, c.effort,
+                                  last_failure.c_str(), f.suspend ? " (suspended)" : ""));
     }
     const int blame = f.blame >= 0 ? f.blame : f.action;
     const std::uint64_t edge = blame >= 0 && blame < static_cast<int>(c.plan.actions.size())

@@ -330,10 +330,11 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
               std::to_string(n_all) + ") while '" + bn + "' is supported";
     }
   }
-  if (std::getenv("WRAP_TASK_DEBUG")) {
+  if (ctx_.Logs("task")) {
     for (int k = 0; k < 2; ++k) {
-      std::fprintf(stderr, "[bwd] input %d '%s' loc0 %d, %d placements; per robot: ", k,
-                   world_.tree->nodes[nodes[k]].name.c_str(), b.loc0[k], b.n_place[k]);
+      std::string line = StrFormat("backward: input %d '%s' loc0 %d, %d placements; per robot: ",
+                                   k, world_.tree->nodes[nodes[k]].name.c_str(), b.loc0[k],
+                                   b.n_place[k]);
       for (int r = 0; r < R; ++r) {
         int n_asm = 0, n = 0;
         for (int g : grasps(k, r)) {
@@ -342,19 +343,19 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
         }
         int n_pick = 0;
         for (int c = 0; c < nc; ++c) n_pick += pick[k][idx_pick(0, r, c)];
-        std::fprintf(stderr, "r%d %d/%d asm, pick0 %d classes; ", r, n_asm, n, n_pick);
+        line += StrFormat("r%d %d/%d asm, pick0 %d classes; ", r, n_asm, n, n_pick);
       }
-      std::fprintf(stderr, "\n");
+      ctx_.Log("task", line);
     }
-    std::fprintf(stderr, "[bwd] rest_asm:");
+    std::string line = "backward: rest_asm:";
     for (int i = 0; i < b.n_rest[1]; ++i) {
-      std::fprintf(stderr, " [");
-      for (int r = 0; r < R; ++r) std::fprintf(stderr, "%d", asm_at(i, r));
-      std::fprintf(stderr, "]");
+      line += " [";
+      for (int r = 0; r < R; ++r) line += std::to_string(asm_at(i, r));
+      line += "]";
     }
-    std::fprintf(stderr, " air_asm:");
-    for (int v : air_asm) std::fprintf(stderr, "%d", v);
-    std::fprintf(stderr, "\n");
+    line += " air_asm:";
+    for (int v : air_asm) line += std::to_string(v);
+    ctx_.Log("task", line);
   }
 }
 

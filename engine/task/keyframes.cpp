@@ -423,12 +423,12 @@ void KeyframeSolver::EnableRobot(int robot, bool on) {
 
 bool KeyframeSolver::Collides() {
   ++counters_.collision_checks;
-  static const bool debug = std::getenv("WRAP_TASK_DEBUG_COLLISIONS") != nullptr;
+  const bool debug = log_ && log_->Logs("task", LogLevel::kTrace);
   if (!debug && !explain_) return cell_.InCollision();
   CollisionResult result;
   const bool hit = cell_.InCollision(&result);
   if (hit && debug) {
-    std::fprintf(stderr, "[task]     collision: %s\n", cell_.Describe(result.first).c_str());
+    log_->Log("task", "    collision: " + cell_.Describe(result.first), LogLevel::kTrace);
   }
   if (hit && explain_) {
     // The failure record's picture of it: every robot's joints, every part's pose, the bodies.

@@ -84,6 +84,8 @@ class KeyframeSolver {
   /// While on, Validate records the cell at each collision it finds (EdgeOutcome::scene), for
   /// the failure record; off (the default) it only counts them.
   void set_explain(bool on) { explain_ = on; }
+  /// Where the collisions of its checks are logged ("task", trace level); null: nowhere.
+  void set_log(const RunContext* log) { log_ = log; }
 
   /// Cheap: the TCP pose is inside the robot's reach sphere.
   bool InReach(int robot, const Iso3& X_WT) const;
@@ -182,6 +184,7 @@ class KeyframeSolver {
   std::vector<std::optional<Fingers>> fingers_;  // per robot (two-finger grippers)
   std::vector<double> opening_;                  // per robot: current finger opening
   bool explain_ = false;                         // record the cell at collisions
+  const RunContext* log_ = nullptr;              // the run's log
   std::vector<JointVector> q_now_;               // per robot: the joints last set
   FailureScene hit_;                             // the cell at the last collision recorded
   void PlaceFingers(int robot, const Iso3& X_WF);

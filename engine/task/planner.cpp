@@ -68,7 +68,7 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
              const Clock::time_point start, std::vector<std::pair<double, int>>& history) {
   const int K = static_cast<int>(order.size());
   int cost = CostOf(incumbent, 0, K);
-  const bool debug = std::getenv("WRAP_TASK_DEBUG") != nullptr;
+  const bool debug = ctx.Logs("task");
   for (int n = 1; n <= K; ++n) {
     for (int i = 0; i + n <= K; ++i) {
       if (ctx.ShouldStop()) return false;
@@ -90,9 +90,10 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
                  : search.FillWindow(i, std::vector<int>(order.begin() + i, order.begin() + i + n),
                                      next, s, c, window);
       if (debug) {
-        std::fprintf(stderr, "[opt] window %d+%d (cost %d, bound %d): %s %zu at %.2f s\n", i, n,
-                     window_cost, window.max_cost, w.ok ? "found" : "none", w.actions.size(),
-                     std::chrono::duration<double>(Clock::now() - start).count());
+        ctx.Log("task", StrFormat("improve: window %d+%d (cost %d, bound %d): %s %zu at %.2f s",
+                                  i, n, window_cost, window.max_cost, w.ok ? "found" : "none",
+                                  w.actions.size(),
+                                  std::chrono::duration<double>(Clock::now() - start).count()));
       }
       if (w.stopped || w.out_of_memory) return false;
       if (!w.ok) continue;
@@ -144,7 +145,7 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
         const double t = std::chrono::duration<double>(Clock::now() - start).count();
         history.push_back({t, cost});
         if (debug) {
-          std::fprintf(stderr, "[opt] window %d+%d: cost %d at %.2f s\n", i, n, cost, t);
+          ctx.Log("task", StrFormat("improve: window %d+%d: cost %d at %.2f s", i, n, cost, t));
         }
       }
     }
@@ -210,6 +211,7 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   TaskTables tables;
   TaskCounters counters;
   KeyframeSolver solver(world, tables, options, std::move(*cell), counters);
+  solver.set_log(&ctx);
   const std::uint64_t seed = ctx.rng()();
   const bool widen = options.widen.value_or(project.planner.widen_grasps);
   TaskSearch search(world, tables, solver, options, ctx, seed, widen);
@@ -283,7 +285,7 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
     }
     failure = r.failure;
     detail = MilestoneFailure(flat ? -1 : k, flat ? -1 : order[k], r);
-    if (std::getenv("WRAP_TASK_DEBUG")) std::fprintf(stderr, "[task] %s\n", failure.c_str());
+    ctx.Log("task", failure);
     if (!flat && k > 0 && backtracks < options.max_backtracks) {
       excluded[k - 1].insert(results[k - 1].end.Hash());
       excluded[k].clear();

@@ -962,9 +962,9 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
       const auto t0 = Clock::now();
       BuildBackward(m, res, s0);
       bwd_s_ += std::chrono::duration<double>(Clock::now() - t0).count();
-      if (std::getenv("WRAP_TASK_DEBUG")) {
-        std::fprintf(stderr, "[task] milestone %d level %d: backward distance %d at the start\n",
-                     index, level, BackwardDistance(s0));
+      if (ctx_.Logs("task")) {
+        ctx_.Log("task", StrFormat("milestone %d level %d: backward distance %d at the start",
+                                   index, level, BackwardDistance(s0)));
       }
       if (!backward_.why.empty()) {
         // The relaxation cannot reach the assembly: neither can the search at this resolution.
@@ -1069,10 +1069,10 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
       SearchStatus status =
           BestFirst(prefix.back().s, m, res, effort, excluded, dead_ends, on_prefix,
                     prefix.size() == 1 ? root_budget : local_budget, g0, max_actions, path);
-      if (std::getenv("WRAP_TASK_DEBUG")) {
-        std::fprintf(stderr,
-                     "[task] milestone %d effort %d depth %d: status %d, %zu nodes, path %zu\n",
-                     index, effort, g0, static_cast<int>(status), nodes_.size(), path.size());
+      if (ctx_.Logs("task")) {
+        ctx_.Log("task", StrFormat("milestone %d effort %d depth %d: status %d, %zu nodes, path %zu",
+                                   index, effort, g0, static_cast<int>(status), nodes_.size(),
+                                   path.size()));
       }
       if (status == SearchStatus::kStopped || status == SearchStatus::kOutOfMemory) {
         return stop(status);
@@ -1109,11 +1109,12 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
           EdgeOutcome outcome = solver_.Validate(s, c, a, next, edge_level, HashMix(seed_, edge));
           solver_.set_explain(false);
           if (!outcome.ok) {
-            if (std::getenv("WRAP_TASK_DEBUG")) {
-              std::fprintf(stderr, "[task]   edge %s r%d r%d obj %d: %s: %s%s\n",
-                           std::string(ToString(a.type)).c_str(), a.r1, a.r2, a.obj,
-                           std::string(GateName(outcome.gate)).c_str(), outcome.message.c_str(),
-                           outcome.permanent ? " (permanent)" : "");
+            if (ctx_.Logs("task")) {
+              ctx_.Log("task", StrFormat("  edge %s r%d r%d obj %d: %s: %s%s",
+                                         std::string(ToString(a.type)).c_str(), a.r1, a.r2, a.obj,
+                                         std::string(GateName(outcome.gate)).c_str(),
+                                         outcome.message.c_str(),
+                                         outcome.permanent ? " (permanent)" : ""));
             }
             CheckSubject about;
             about.object = a.obj;

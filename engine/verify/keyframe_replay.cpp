@@ -216,12 +216,7 @@ class Timer {
           up1.push_back(*b);
         }
         if (up1.size() != robots.size()) continue;
-        if (!ClearOfTable(robots, up0, up1)) {
-          if (std::getenv("WRAP_SIM_DEBUG")) {
-            std::fprintf(stderr, "[replay] action %d: raised by %.1f m not clear\n", action, h);
-          }
-          continue;
-        }
+        if (!ClearOfTable(robots, up0, up1)) continue;  // higher, or the note below
         Move(SegmentKind::kFree, action, robots, up0, objects, kRaiseSpeed_mps);
         Move(SegmentKind::kFree, action, robots, up1, objects);
         Move(SegmentKind::kFree, action, robots, goals, std::move(objects), kRaiseSpeed_mps);

@@ -461,14 +461,12 @@ class Simulator {
 
   void Failed(int action, const std::string& reason, const std::string& detail, double t) {
     if (report_.failure) return;
-    if (std::getenv("WRAP_SIM_DEBUG")) {
-      for (int c = 0; c < data_->ncon; ++c) {
-        const mjContact& con = data_->contact[c];
-        const char* n1 = mj_id2name(model_.get(), mjOBJ_BODY, model_->geom_bodyid[con.geom1]);
-        const char* n2 = mj_id2name(model_.get(), mjOBJ_BODY, model_->geom_bodyid[con.geom2]);
-        std::fprintf(stderr, "[contact] %s - %s dist %.4f\n", n1 ? n1 : "world", n2 ? n2 : "world",
-                     con.dist);
-      }
+    for (int c = 0; c < data_->ncon && ctx_.Logs("sim"); ++c) {
+      const mjContact& con = data_->contact[c];
+      const char* n1 = mj_id2name(model_.get(), mjOBJ_BODY, model_->geom_bodyid[con.geom1]);
+      const char* n2 = mj_id2name(model_.get(), mjOBJ_BODY, model_->geom_bodyid[con.geom2]);
+      ctx_.Log("sim", StrFormat("contact at the failure: %s - %s dist %.4f", n1 ? n1 : "world",
+                                n2 ? n2 : "world", con.dist));
     }
     report_.failure = SimFailure{action, reason, detail, t};
     if (action >= 0) report_.actions[action].status = "failed";
@@ -1072,9 +1070,12 @@ class Simulator {
       }
       prev_f_[r] = f;
       prev_tau_[r] = tau;
-      if (const char* who = std::getenv("WRAP_SIM_TRACE"); who && scene_.robots[r].name == who) {
-        std::fprintf(stderr, "[sim] t %.4f %s u %.3f f %.2f %.2f %.2f tau %.3f %.3f %.3f\n", t, who,
-                     u, f.x(), f.y(), f.z(), tau.x(), tau.y(), tau.z());
+      if (ctx_.Logs("sim", LogLevel::kTrace)) {
+        ctx_.Log("sim",
+                 StrFormat("t %.4f %s u %.3f f %.2f %.2f %.2f tau %.3f %.3f %.3f", t,
+                           scene_.robots[r].name.c_str(), u, f.x(), f.y(), f.z(), tau.x(), tau.y(),
+                           tau.z()),
+                 LogLevel::kTrace);
       }
       double& peak = vacuum ? (insert_action >= 0 ? report_.peak.vacuum_insertion
                                                   : report_.peak.vacuum_transport)
@@ -1281,11 +1282,10 @@ Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check
     }
   }
   const Plan& run = timed ? *timed : plan;
-  if (timed && std::getenv("WRAP_SIM_DEBUG")) {
-    for (const MotionSegment& m : run.segments) {
-      std::fprintf(stderr, "[replay] %s action %d robots %zu: %.3f - %.3f s\n", m.kind.c_str(),
-                   m.action, m.robots.size(), m.start_s, m.end_s);
-    }
+  for (size_t k = 0; timed && k < run.segments.size() && ctx.Logs("sim"); ++k) {
+    const MotionSegment& m = run.segments[k];
+    ctx.Log("sim", StrFormat("segment: %s action %d robots %zu: %.3f - %.3f s", m.kind.c_str(),
+                             m.action, m.robots.size(), m.start_s, m.end_s));
   }
   if (run.trajectories.size() != scene->robots.size()) {
     return bad("trajectories: " + std::to_string(run.trajectories.size()) +

@@ -83,6 +83,31 @@ TEST(PlanCli, PlansValidatesAndWritesThePlan) {
   EXPECT_NE(caught.err.find("Trajectory check FAILED"), std::string::npos) << caught.err;
 }
 
+// --log writes the topics' lines to stderr and changes nothing in the plan; an unknown topic is
+// a usage error listing the known ones.
+TEST(PlanCli, LogTopicsGoToStderrAndLeaveThePlanAlone) {
+  const fs::path dir = TempDir("log");
+  const CliRun quiet =
+      Wrap({"plan", Project("half_stool"), "-o", (dir / "quiet.json").string()});
+  ASSERT_EQ(quiet.code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err.find("[motion]"), std::string::npos) << quiet.err;
+  const CliRun logged = Wrap({"plan", Project("half_stool"), "-o", (dir / "logged.json").string(),
+                              "--log", "motion,task"});
+  ASSERT_EQ(logged.code, 0) << logged.err;
+  EXPECT_NE(logged.err.find("[motion] free: action 1"), std::string::npos) << logged.err;
+  EXPECT_NE(logged.err.find("[task] milestone 0"), std::string::npos) << logged.err;
+  auto actions = [](const fs::path& file) {
+    std::ifstream in(file);
+    const nlohmann::json plan = nlohmann::json::parse(in);
+    return plan["actions"].dump() + plan["trajectories"].dump();
+  };
+  EXPECT_EQ(actions(dir / "logged.json"), actions(dir / "quiet.json"));
+  const CliRun bad = Wrap({"plan", Project("half_stool"), "--log", "motoin"});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("unknown log topic 'motoin'"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("motion.diag"), std::string::npos) << bad.err;
+}
+
 TEST(PlanCli, SeedAndWrenchModeReachTheStats) {
   const fs::path dir = TempDir("seed");
   const fs::path out = dir / "plan.json";

@@ -2,7 +2,9 @@
 
 #include <filesystem>
 #include <numbers>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "core/diagnostics.h"
 #include "core/file_io.h"
@@ -136,6 +138,48 @@ TEST(RunContext, SameSeedSameNumbers) {
   EXPECT_EQ(a.rng()(), b.rng()());
   RunContext a2(7);
   EXPECT_NE(a2.rng()(), c.rng()());
+}
+
+TEST(Log, TopicsParseWithLevelsAndNameWhatIsWrong) {
+  auto t = LogTopics::Parse("motion,task:trace");
+  ASSERT_TRUE(t.has_value()) << t.error().message;
+  EXPECT_TRUE(t->Enabled("motion", LogLevel::kDebug));
+  EXPECT_FALSE(t->Enabled("motion", LogLevel::kTrace));
+  EXPECT_TRUE(t->Enabled("task", LogLevel::kTrace));
+  EXPECT_FALSE(t->Enabled("sim", LogLevel::kDebug));
+  EXPECT_FALSE(t->Enabled("motion.diag", LogLevel::kDebug));  // not implied by "motion"
+  auto all = LogTopics::Parse("all");
+  ASSERT_TRUE(all.has_value());
+  EXPECT_TRUE(all->Enabled("sim", LogLevel::kDebug));
+  EXPECT_FALSE(all->Enabled("sim", LogLevel::kTrace));
+  auto none = LogTopics::Parse("");
+  ASSERT_TRUE(none.has_value());
+  EXPECT_TRUE(none->empty());
+  auto bad = LogTopics::Parse("motion,plannr");
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find("unknown log topic 'plannr'"), std::string::npos);
+  EXPECT_NE(bad.error().message.find("motion.diag"), std::string::npos);  // lists the known
+  auto level = LogTopics::Parse("task:loud");
+  ASSERT_FALSE(level.has_value());
+  EXPECT_NE(level.error().message.find("'loud'"), std::string::npos);
+}
+
+TEST(Log, RunContextSendsOnlyEnabledLinesToItsSink) {
+  RunContext ctx;
+  EXPECT_FALSE(ctx.Logs("motion"));  // no sink: nothing logged
+  std::vector<std::string> lines;
+  ctx.set_log([&](std::string_view topic, LogLevel,
+                  const std::string& text) { lines.push_back(std::string(topic) + ": " + text); },
+              *LogTopics::Parse("motion"));
+  ctx.Log("motion", StrFormat("query %d: %s", 3, "solved"));
+  ctx.Log("motion", "every check", LogLevel::kTrace);
+  ctx.Log("task", "a fill");
+  RunContext sub;
+  sub.set_log_from(ctx);
+  sub.Log("motion", "from a sub-run");
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "motion: query 3: solved");
+  EXPECT_EQ(lines[1], "motion: from a sub-run");
 }
 
 TEST(RunContext, StageTimerAccumulates) {

@@ -338,7 +338,9 @@ TEST(PlannerInfeasible, TheReportsChecksSayWhatWasTried) {
   bool table_named = false;
   for (size_t i = 0; i < f.cases.size(); ++i) {
     const FailureCase& c = f.cases[i];
-    if (i > 0) EXPECT_GE(f.cases[i - 1].count, c.count) << "blocker first";
+    if (i > 0) {
+      EXPECT_GE(f.cases[i - 1].count, c.count) << "blocker first";
+    }
     EXPECT_NE(f.text.find(c.text), std::string::npos) << c.text << " in " << f.text;
     EXPECT_EQ(c.scene.X_WP.size(), project.parts.size()) << c.check;
     EXPECT_EQ(c.scene.q.size(), project.robots.size()) << c.check;
