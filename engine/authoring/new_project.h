@@ -39,8 +39,8 @@ struct NewProjectResult {
 /// relative to `output`. Fails with kInvalidInput for bad meshes (none, one, unreadable, not
 /// closed, overlapping where assembled, not all connected), kInfeasible when the parts are
 /// interlocked (naming them) or cannot be laid out. Deterministic.
-Result<NewProjectResult> NewProject(const std::vector<std::filesystem::path>& meshes,
-                                    const std::filesystem::path& output,
-                                    const NewProjectOptions& options);
+[[nodiscard]] Result<NewProjectResult> NewProject(const std::vector<std::filesystem::path>& meshes,
+                                                  const std::filesystem::path& output,
+                                                  const NewProjectOptions& options);
 
 }  // namespace wrap

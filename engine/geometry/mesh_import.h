@@ -26,7 +26,7 @@ struct MeshImportOptions {
 /// triangles whose corners weld together. Does not throw; damaged files on which assimp 5.2 is
 /// known to hang or abort are rejected before it reads them, but assimp is not proof against
 /// every hostile file (mesh_import.cpp lists what fuzzing found).
-Result<TriangleMesh> ImportMesh(const std::filesystem::path& path,
-                                const MeshImportOptions& options = {});
+[[nodiscard]] Result<TriangleMesh> ImportMesh(const std::filesystem::path& path,
+                                              const MeshImportOptions& options = {});
 
 }  // namespace wrap

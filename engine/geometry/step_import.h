@@ -74,8 +74,8 @@ bool LooksLikeStep(const std::filesystem::path& path);
 /// deflections out of range; a build without OpenCASCADE fails with kInvalidInput saying that
 /// STEP is unavailable. Thread-safe (OpenCASCADE is used by one thread at a time). Does not
 /// throw.
-Result<StepAssembly> ImportStep(const std::filesystem::path& path,
-                                const StepTessellation& tessellation = {});
+[[nodiscard]] Result<StepAssembly> ImportStep(const std::filesystem::path& path,
+                                              const StepTessellation& tessellation = {});
 
 /// Every instance's mesh placed in the assembly frame, in one mesh [m] (what a part whose mesh is
 /// the whole file gets).

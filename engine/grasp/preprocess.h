@@ -79,7 +79,7 @@ struct Preprocessed {
 /// Checks ctx.ShouldStop() in every loop; adds its wall time to ctx's stage "grasp".
 /// Fails with kInvalidInput (no DAG, a mesh missing, an unknown end effector, a non-positive
 /// grasp count or friction), kCancelled / kTimeout when stopped, kInternal on a qhull failure.
-Result<Preprocessed> Preprocess(const Project& project, const ProjectCheck& check,
-                                const PreprocessOptions& options, RunContext& ctx);
+[[nodiscard]] Result<Preprocessed> Preprocess(const Project& project, const ProjectCheck& check,
+                                              const PreprocessOptions& options, RunContext& ctx);
 
 }  // namespace wrap

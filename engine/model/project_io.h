@@ -30,6 +30,6 @@ ProjectParse ReadProjectFile(const std::filesystem::path& path);
 std::string SerializeProject(const Project& project);
 
 /// Writes the project atomically (temporary file + rename): never a half-written file.
-Result<void> SaveProject(const Project& project, const std::filesystem::path& path);
+[[nodiscard]] Result<void> SaveProject(const Project& project, const std::filesystem::path& path);
 
 }  // namespace wrap

@@ -93,7 +93,8 @@ struct KeyframeOptReport {
 /// deadline the best choices so far are written. Fails with kInvalidInput when the plan does not
 /// match the world (robot count, joint vector sizes, robot, part or node indices) and with
 /// kInternal when the collision cell cannot be built.
-Result<KeyframeOptReport> OptimizeKeyframes(const TaskWorld& world, Plan& plan,
-                                            const KeyframeOptOptions& options, RunContext& ctx);
+[[nodiscard]] Result<KeyframeOptReport> OptimizeKeyframes(const TaskWorld& world, Plan& plan,
+                                                          const KeyframeOptOptions& options,
+                                                          RunContext& ctx);
 
 }  // namespace wrap

@@ -29,8 +29,9 @@ struct MotionAttempt {
 /// With options.self_check, timed trajectories that fail the independent check are not kept:
 /// the attempt fails (segment "timed", not to be retried) naming the first issue.
 /// Fails with kCancelled when ctx is cancelled, kInvalidInput when the plan does not fit the world.
-Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const MotionOptions& options,
-                                 int effort, std::uint64_t seed, MotionCache& cache,
-                                 RunContext& ctx);
+[[nodiscard]] Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan,
+                                               const MotionOptions& options, int effort,
+                                               std::uint64_t seed, MotionCache& cache,
+                                               RunContext& ctx);
 
 }  // namespace wrap

@@ -36,7 +36,8 @@ struct Timing {
 /// Times the geometric motion `segments` of `plan` (from PlanGeometricMotion); `log` (may be
 /// null) gets, under "motion", what each segment waits for. Fails with kInvalidInput when a
 /// segment's robots or waypoints do not fit the world.
-Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
-                      const std::vector<GeoSegment>& segments, const RunContext* log = nullptr);
+[[nodiscard]] Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
+                                    const std::vector<GeoSegment>& segments,
+                                    const RunContext* log = nullptr);
 
 }  // namespace wrap

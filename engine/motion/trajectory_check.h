@@ -69,7 +69,7 @@ std::string FormatTrajectoryIssue(const Plan& plan, const TrajectoryIssue& issue
 /// from above, the two inputs of an insertion during its insert window, a gripper and the object
 /// of its approach or retreat window). Fails with kInvalidInput when the plan has no trajectories
 /// or names robots or nodes the world lacks.
-Result<TrajectoryCheck> CheckTrajectories(const TaskWorld& world, const Plan& plan,
-                                          const TrajectoryCheckOptions& options = {});
+[[nodiscard]] Result<TrajectoryCheck> CheckTrajectories(const TaskWorld& world, const Plan& plan,
+                                                        const TrajectoryCheckOptions& options = {});
 
 }  // namespace wrap

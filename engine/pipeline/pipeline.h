@@ -40,7 +40,8 @@ struct PipelineOptions {
 /// found but no motion, solved is false and stats.failure names the action and segment that could
 /// not be planned and why (the plan keeps its keyframes). Stage times: the task planner's, "kf",
 /// "mp", "retime". Fails like PlanTask (kInvalidInput, kCancelled).
-Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
-                          const Preprocessed& pre, const PipelineOptions& options, RunContext& ctx);
+[[nodiscard]] Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
+                                        const Preprocessed& pre, const PipelineOptions& options,
+                                        RunContext& ctx);
 
 }  // namespace wrap

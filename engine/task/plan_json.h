@@ -44,7 +44,7 @@ Result<Plan> ParsePlan(std::string_view text, const std::string& origin);
 Result<Plan> ReadPlanFile(const std::filesystem::path& path);
 
 /// Writes the plan to `path` atomically. Fails with kIo naming the path.
-Result<void> SavePlan(const Plan& plan, const std::filesystem::path& path);
+[[nodiscard]] Result<void> SavePlan(const Plan& plan, const std::filesystem::path& path);
 
 /// Checks that a parsed plan belongs to `project` (with its DAG `tree`): the same robots, parts
 /// and nodes in the same order, milestones that are steps, joint vectors of each robot's chain

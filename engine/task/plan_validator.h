@@ -113,8 +113,9 @@ std::string FormatIssue(const PlanIssue& issue);
 Result<void> AnnotateUtilisation(const Project& project, const ProjectCheck& check, Plan& plan,
                                  const std::filesystem::path& project_file = {});
 
-Result<PlanValidation> ValidatePlan(const Project& project, const ProjectCheck& check,
-                                    const Plan& plan, const PlanValidationOptions& options,
-                                    const std::filesystem::path& project_file);
+[[nodiscard]] Result<PlanValidation> ValidatePlan(const Project& project, const ProjectCheck& check,
+                                                  const Plan& plan,
+                                                  const PlanValidationOptions& options,
+                                                  const std::filesystem::path& project_file);
 
 }  // namespace wrap

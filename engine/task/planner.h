@@ -73,8 +73,9 @@ struct TaskPlannerOptions {
 /// planner cannot set up (a robot model that does not load), kCancelled when ctx is cancelled.
 /// Deterministic: same inputs and ctx seed, same plan. Adds its stage times to ctx ("bwd", "lp",
 /// "fwd", "ik").
-Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const Preprocessed& pre,
-                      const TaskPlannerOptions& options, RunContext& ctx);
+[[nodiscard]] Result<Plan> PlanTask(const Project& project, const ProjectCheck& check,
+                                    const Preprocessed& pre, const TaskPlannerOptions& options,
+                                    RunContext& ctx);
 
 /// A part that no robot can pick where it starts.
 struct UnpickablePart {

@@ -134,9 +134,10 @@ struct SimReport {
 /// "trajectories: ..." or "actions[3]: ..."; callers prefix the plan file), kInternal with MuJoCo's
 /// message when MuJoCo raises an error (never exits), kCancelled when `ctx` stops. A plan that
 /// fails in simulation is a SimReport with success false, not an error.
-Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check,
-                               const std::filesystem::path& project_file, const Plan& plan,
-                               const SimOptions& options, RunContext& ctx);
+[[nodiscard]] Result<SimReport> SimulatePlan(const Project& project, const ProjectCheck& check,
+                                             const std::filesystem::path& project_file,
+                                             const Plan& plan, const SimOptions& options,
+                                             RunContext& ctx);
 
 /// The report as JSON text (2-space indent, final newline): success, tasks, actions, peak
 /// utilisations in percent (null where absent), failure {action, reason, detail, t_s} or null.

@@ -767,7 +767,9 @@ TEST(WrenchRelaxation, NeverRefusesWhatSomeOrientationHolds) {
                          .toRotationMatrix();
       const bool full = MustCheck(Turned(c, R)).feasible;
       held += full ? 1 : 0;
-      if (full) EXPECT_TRUE(relaxed) << "trial " << trial << " orientation " << k;
+      if (full) {
+        EXPECT_TRUE(relaxed) << "trial " << trial << " orientation " << k;
+      }
     }
     refused_by_relaxation += relaxed ? 0 : 1;
   }
