@@ -98,11 +98,9 @@ Result<MeshIntake> ReadStepAssembly(const fs::path& file, LengthUnit unit) {
   MeshIntake out;
   for (const StepInstance& inst : assembly->instances) {
     const StepSolid& solid = assembly->solids[static_cast<size_t>(inst.solid)];
-    TriangleMesh mesh = solid.mesh;
-    for (Vec3& v : mesh.vertices) v = inst.X_AS * v;
     out.names.push_back(inst.name);
     out.files.push_back(file);
-    out.meshes.push_back(std::move(mesh));
+    out.meshes.push_back(Transformed(solid.mesh, inst.X_AS));
     out.solids.push_back(solid.name);
     out.X_AP.push_back(inst.X_AS);
     out.colors.push_back(inst.color);

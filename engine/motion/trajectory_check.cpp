@@ -451,13 +451,14 @@ void Checker::CheckDense() {
     CollisionRequest request;
     if (cell->InCollision(&hit, request)) {
       const auto key = std::minmax(hit.first.body_a.value, hit.first.body_b.value);
-      for (const auto& [node, thing] : s.things) {
-        if (!opt_.log || !opt_.log->Logs("motion")) break;
-        opt_.log->Log("motion",
-                      StrFormat("check: t=%.2f %s resting %d holders %zu X_WA %.3f %.3f %.3f", t,
-                                plan_.nodes[node].c_str(), thing.resting, thing.holders.size(),
-                                thing.X_WA.translation().x(), thing.X_WA.translation().y(),
-                                thing.X_WA.translation().z()));
+      if (opt_.log != nullptr && opt_.log->Logs("motion")) {
+        for (const auto& [node, thing] : s.things) {
+          opt_.log->Log("motion",
+                        StrFormat("check: t=%.2f %s resting %d holders %zu X_WA %.3f %.3f %.3f",
+                                  t, plan_.nodes[node].c_str(), thing.resting,
+                                  thing.holders.size(), thing.X_WA.translation().x(),
+                                  thing.X_WA.translation().y(), thing.X_WA.translation().z()));
+        }
       }
       if (reported.insert(key).second) {
         Issue(t, cell->robot_of(hit.first.body_a), "collision",

@@ -423,11 +423,10 @@ void KeyframeSolver::EnableRobot(int robot, bool on) {
 
 bool KeyframeSolver::Collides() {
   ++counters_.collision_checks;
-  const bool debug = log_ && log_->Logs("task", LogLevel::kTrace);
-  if (!debug && !explain_) return cell_.InCollision();
+  if (!trace_collisions_ && !explain_) return cell_.InCollision();
   CollisionResult result;
   const bool hit = cell_.InCollision(&result);
-  if (hit && debug) {
+  if (hit && trace_collisions_) {
     log_->Log("task", "    collision: " + cell_.Describe(result.first), LogLevel::kTrace);
   }
   if (hit && explain_) {

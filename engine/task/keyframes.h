@@ -85,7 +85,10 @@ class KeyframeSolver {
   /// the failure record; off (the default) it only counts them.
   void set_explain(bool on) { explain_ = on; }
   /// Where the collisions of its checks are logged ("task", trace level); null: nowhere.
-  void set_log(const RunContext* log) { log_ = log; }
+  void set_log(const RunContext* log) {
+    log_ = log;
+    trace_collisions_ = log != nullptr && log->Logs("task", LogLevel::kTrace);
+  }
 
   /// Cheap: the TCP pose is inside the robot's reach sphere.
   bool InReach(int robot, const Iso3& X_WT) const;
@@ -185,6 +188,7 @@ class KeyframeSolver {
   std::vector<double> opening_;                  // per robot: current finger opening
   bool explain_ = false;                         // record the cell at collisions
   const RunContext* log_ = nullptr;              // the run's log
+  bool trace_collisions_ = false;                // log_ takes "task" at trace level
   std::vector<JointVector> q_now_;               // per robot: the joints last set
   FailureScene hit_;                             // the cell at the last collision recorded
   void PlaceFingers(int robot, const Iso3& X_WF);

@@ -36,7 +36,7 @@ for tool in munged slurmctld slurmd sbatch squeue scontrol scancel; do
 done
 
 # Everything lives here; the socket's folders must be searchable by all (munged checks).
-tmp=$(mktemp -d /tmp/wrap-cluster-test.XXXXXX)
+tmp=$(mktemp -d -t wrap-cluster-test.XXXXXX)
 chmod 755 "$tmp"
 mkdir -p "$tmp/munge" "$tmp/key" "$tmp/state" "$tmp/spool" "$tmp/log"
 chmod 755 "$tmp/munge"
