@@ -84,6 +84,38 @@ bool Converged(const Residual& r, const NumericIkOptions& options) {
          r.rotation_rad <= options.rotation_tolerance_rad;
 }
 
+// The damped least-squares step dq = (Jw^T Jw + lambda I)^-1 Jw^T e of the weighted Jacobian
+// Jw (rotation rows scaled by `w`), with the joints at a limit whose gradient points out of the
+// range held (their columns of Jw zeroed, dq_i = 0). For 6 or more joints it is solved in the
+// task space, dq = Jw^T (Jw Jw^T + lambda I)^-1 e (the same step: a fixed 6 x 6 system, the
+// planner's IK hot path); for fewer joints in the joint space, the smaller system.
+JointVector DampedStep(const Chain& chain, const Jacobian& J, double w, const JointVector& q,
+                       const Vec6& e, double lambda) {
+  const int n = chain.dof();
+  Jacobian Jw = J;
+  Jw.bottomRows<3>() *= w;
+  for (int i = 0; i < n; ++i) {
+    const Joint& joint = chain.joints[i];
+    const double g = Jw.col(i).dot(e);
+    const bool at_lower = q[i] <= joint.lower + 1e-12 && g < 0.0;
+    const bool at_upper = q[i] >= joint.upper - 1e-12 && g > 0.0;
+    if (at_lower || at_upper) Jw.col(i).setZero();
+  }
+  if (n >= 6) {
+    Eigen::Matrix<double, 6, 6> M = Eigen::Matrix<double, 6, 6>::Zero();
+    for (int i = 0; i < n; ++i) M.noalias() += Jw.col(i) * Jw.col(i).transpose();
+    M.diagonal().array() += lambda;
+    const Vec6 y = M.llt().solve(e);
+    JointVector dq(n);
+    for (int i = 0; i < n; ++i) dq[i] = Jw.col(i).dot(y);
+    return dq;
+  }
+  SquareMatrix A = Jw.transpose().lazyProduct(Jw);
+  A.diagonal().array() += lambda;
+  const JointVector g = Jw.transpose().lazyProduct(e);
+  return A.llt().solve(g);
+}
+
 // One Levenberg-Marquardt descent from `q` (clamped into the limits). Returns the last iterate
 // and its residual; `iterations` counts the FK + Jacobian evaluations.
 struct Descent {
@@ -94,7 +126,6 @@ struct Descent {
 
 Descent Descend(const Chain& chain, const NumericIkRequest& request, const JointVector& start,
                 const NumericIkOptions& options) {
-  const int n = chain.dof();
   const Iso3 X_BB = Iso3::Identity();
   const double w = options.rotation_weight_m;
   Descent d;
@@ -106,25 +137,7 @@ Descent Descend(const Chain& chain, const NumericIkRequest& request, const Joint
   double lambda = options.initial_damping;
   int slow = 0;
   while (d.iterations < options.max_iterations && !Converged(d.residual, options)) {
-    // Weighted Jacobian and gradient of the cost 0.5 |e|^2 (descent direction Jw^T e).
-    Jacobian Jw = J;
-    Jw.bottomRows<3>() *= w;
-    JointVector g = Jw.transpose() * d.residual.e;
-    SquareMatrix A = Jw.transpose() * Jw;
-    // Active set: hold a joint at a limit when the descent direction points out of the range.
-    for (int i = 0; i < n; ++i) {
-      const Joint& joint = chain.joints[i];
-      const bool at_lower = d.q[i] <= joint.lower + 1e-12 && g[i] < 0.0;
-      const bool at_upper = d.q[i] >= joint.upper - 1e-12 && g[i] > 0.0;
-      if (at_lower || at_upper) {
-        A.row(i).setZero();
-        A.col(i).setZero();
-        A(i, i) = 1.0;
-        g[i] = 0.0;
-      }
-    }
-    A.diagonal().array() += lambda;
-    JointVector dq = A.llt().solve(g);
+    JointVector dq = DampedStep(chain, J, w, d.q, d.residual.e, lambda);
     const double largest = dq.cwiseAbs().maxCoeff();
     if (!(largest <= options.max_step)) {
       if (!std::isfinite(largest)) break;
@@ -356,6 +369,10 @@ Result<NumericIkResult> SolveNumericIk(const Chain& chain, const NumericIkReques
       residuals.push_back(d.residual);
     }
     if (!options.all_branches) break;
+    if (options.max_branches > 0 &&
+        static_cast<int>(result.branches.size()) >= options.max_branches) {
+      break;
+    }
   }
 
   if (result.branches.empty()) {

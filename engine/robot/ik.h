@@ -108,6 +108,10 @@ struct NumericIkOptions {
   double max_step = 0.4;
   /// Run every start and return every distinct branch; otherwise stop at the first success.
   bool all_branches = false;
+  /// With all_branches: stop once this many distinct branches are found (0: run every start).
+  /// A redundant arm finds a new branch at almost every start, so a caller that keeps only the
+  /// nearest few saves the remaining starts.
+  int max_branches = 0;
   /// Solutions that differ by less than this in every joint (revolute joints modulo 2 pi) are one
   /// branch; the one nearer the reference is kept [rad or m]. Default 0.05.
   double branch_separation = 0.05;

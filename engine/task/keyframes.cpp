@@ -389,6 +389,7 @@ bool KeyframeSolver::SolveIk(int robot, const Iso3& X_WT, const JointVector& ref
     NumericIkOptions o;
     o.restarts = kNumericRestarts[std::clamp(effort, 0, 2)];
     o.all_branches = effort > 0;
+    o.max_branches = kMaxSolutionsPerRobot;
     o.position_tolerance_m = 1e-4;
     o.rotation_tolerance_rad = 1e-3;
     auto result = SolveNumericIk(r.chain, request, rng, o);

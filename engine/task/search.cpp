@@ -1110,8 +1110,8 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
           solver_.set_explain(false);
           if (!outcome.ok) {
             if (ctx_.Logs("task")) {
-              ctx_.Log("task", StrFormat("  edge %s r%d r%d obj %d: %s: %s%s",
-                                         std::string(ToString(a.type)).c_str(), a.r1, a.r2, a.obj,
+              ctx_.Log("task", StrFormat("  edge %s r%d r%d obj %d g%d l%d: %s: %s%s",
+                                         std::string(ToString(a.type)).c_str(), a.r1, a.r2, a.obj, a.grasp, a.loc,
                                          std::string(GateName(outcome.gate)).c_str(),
                                          outcome.message.c_str(),
                                          outcome.permanent ? " (permanent)" : ""));

@@ -295,5 +295,61 @@ TEST(NumericIk, SameSeedSameAnswer) {
   EXPECT_EQ(rng_a(), rng_b());
 }
 
+TEST(NumericIk, MaxBranchesStopsOnceEnoughAreFound) {
+  const Chain arm = LoadOrDie("openarm");
+  JointVector q(7);
+  q << 0.4, 0.3, -0.2, 1.2, 0.1, 0.3, -0.5;
+  NumericIkRequest request;
+  request.X_BT = FlangePose(arm, Iso3::Identity(), q);
+  NumericIkOptions all;
+  all.all_branches = true;
+  all.restarts = 20;
+  std::mt19937_64 rng_all(7);
+  Result<NumericIkResult> every = SolveNumericIk(arm, request, rng_all, all);
+  ASSERT_TRUE(every.has_value()) << every.error().message;
+  // A 7-DoF arm finds a new branch at almost every start.
+  ASSERT_GT(every->branches.size(), 3u);
+  NumericIkOptions capped = all;
+  capped.max_branches = 3;
+  std::mt19937_64 rng_capped(7);
+  Result<NumericIkResult> few = SolveNumericIk(arm, request, rng_capped, capped);
+  ASSERT_TRUE(few.has_value()) << few.error().message;
+  EXPECT_EQ(few->branches.size(), 3u);
+  EXPECT_LT(few->starts, every->starts);
+  EXPECT_LT(few->iterations, every->iterations);
+  for (const JointVector& branch : few->branches) {
+    const Iso3 X = FlangePose(arm, Iso3::Identity(), branch);
+    EXPECT_LE(PositionError(X, request.X_BT), capped.position_tolerance_m);
+    EXPECT_TRUE(WithinLimits(arm, branch));
+  }
+}
+
+TEST(NumericIk, JointsHeldAtALimitStillReachTargetsNearTheLimit) {
+  // Targets generated with joint 4 at its lower limit (0) and joint 6 at its upper limit: the
+  // descent must hold those joints (the active set) and still converge with the rest.
+  const Chain arm = LoadOrDie("openarm");
+  std::mt19937_64 targets(71);
+  std::mt19937_64 rng(72);
+  NumericIkOptions options;
+  options.restarts = 20;
+  int solved = 0;
+  const int trials = 100;
+  for (int trial = 0; trial < trials; ++trial) {
+    JointVector q = RandomConfiguration(arm, targets);
+    q[3] = arm.joints[3].lower;
+    q[5] = arm.joints[5].upper;
+    NumericIkRequest request;
+    request.X_BT = FlangePose(arm, Iso3::Identity(), q);
+    Result<NumericIkResult> result = SolveNumericIk(arm, request, rng, options);
+    if (!result) continue;
+    ++solved;
+    EXPECT_TRUE(WithinLimits(arm, result->q));
+    const Iso3 X = FlangePose(arm, Iso3::Identity(), result->q);
+    EXPECT_LE(PositionError(X, request.X_BT), options.position_tolerance_m);
+    EXPECT_LE(RotationError(X, request.X_BT), options.rotation_tolerance_rad);
+  }
+  EXPECT_GE(solved, trials * 95 / 100) << solved << " of " << trials;
+}
+
 }  // namespace
 }  // namespace wrap
