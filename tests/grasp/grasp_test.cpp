@@ -337,9 +337,9 @@ TEST(Preprocess, StopsWhenCancelledOrOutOfTime) {
     EXPECT_EQ(r.error().code, ErrorCode::kTimeout);
   }
   {
-    // Cancel while it samples a large grasp set: it must answer the stop (the bound only catches
-    // a hang; the latency itself depends on the machine's load and is not asserted). A machine
-    // fast enough to finish before the stop is asked again sooner.
+    // Cancel while it samples a large grasp set: it must answer the stop (the latency depends on
+    // the machine's load and is not asserted; a hang would meet ctest's timeout). A machine fast
+    // enough to finish before the stop is asked again sooner.
     bool stopped_midway = false;
     for (int delay_ms : {100, 20, 2}) {
       std::stop_source stop;
@@ -347,18 +347,12 @@ TEST(Preprocess, StopsWhenCancelledOrOutOfTime) {
       ctx.set_stop_token(stop.get_token());
       PreprocessOptions o = Quick(2000);
       Result<Preprocessed> r = Fail(ErrorCode::kInternal, "not run");
-      std::chrono::steady_clock::time_point done;
-      std::thread worker([&] {
-        r = Preprocess(s.project, s.check, o, ctx);
-        done = std::chrono::steady_clock::now();
-      });
+      std::thread worker([&] { r = Preprocess(s.project, s.check, o, ctx); });
       std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
-      const auto asked = std::chrono::steady_clock::now();
       stop.request_stop();
       worker.join();
       if (r) continue;  // finished before the stop
       EXPECT_EQ(r.error().code, ErrorCode::kCancelled) << r.error().message;
-      EXPECT_LT(std::chrono::duration<double>(done - asked).count(), 5.0) << "a hang";
       stopped_midway = true;
       break;
     }

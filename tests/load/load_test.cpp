@@ -57,8 +57,8 @@ std::string Timeless(Plan plan) {
 
 // 100 runs of the whole pipeline, each stopped after a random delay (0 to 0.6 s: through
 // preprocessing, the task search, keyframe optimisation and motion). Each ends kCancelled or with
-// a solved plan; the stop is answered (the watchdog bound of 5 s only catches a hang: the latency
-// itself is a measurement, printed here and benchmarked, not asserted); the heap comes back.
+// a solved plan; the stop is answered (the latency is a measurement, printed here and
+// benchmarked, not asserted; a hang would meet ctest's timeout); the heap comes back.
 TEST(Load, CancelledAtRandomMomentsAlwaysStops) {
   const std::vector<std::string> names = {"half_stool", "cross", "stool"};
   std::vector<LoadedProject> projects;
@@ -102,8 +102,6 @@ TEST(Load, CancelledAtRandomMomentsAlwaysStops) {
       ++cancelled;
       const double ms = std::chrono::duration<double, std::milli>(returned_at - stopped_at).count();
       latency_ms.push_back(ms);
-      EXPECT_LT(ms, 5000.0) << names[k] << " run " << run << " (stop after " << delay
-                            << " s) did not answer the stop: a hang";
     }
     if (run + 1 == kWarmup) heap_after_warmup = HeapInUseMiB();
   }

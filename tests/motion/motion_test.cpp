@@ -135,12 +135,12 @@ TEST(OmplAdapter, NoPathTimesOutAndStopsOnRequest) {
   EXPECT_LT(a.checks, 5000 + 1000);
   q.max_checks = 1LL << 40;
   q.stop = [] { return true; };
-  const auto t0 = std::chrono::steady_clock::now();
   a = PlanPath(q);
   EXPECT_FALSE(a.solved);
   EXPECT_FALSE(a.timed_out);
-  // A stop already requested ends the search at its first check; 5 s only catches a hang.
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  // A stop already requested ends the search before it spends its budget: counted in checks,
+  // not seconds (a hang would meet ctest's timeout).
+  EXPECT_LT(a.checks, 1000);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -607,9 +607,9 @@ TEST(Motion, CancelStopsWithinAFractionOfASecond) {
     EXPECT_EQ(plan.error().code, ErrorCode::kCancelled);
   }
   // The stop's latency is a measurement (printed; Load.CancelledAtRandomMomentsAlwaysStops
-  // reports its distribution), not asserted against the wall clock: 5 s only catches a hang.
+  // reports its distribution), not asserted against the wall clock: a hang would meet ctest's
+  // timeout, as the searches' budgets above are practically endless.
   std::printf("motion run stopped %.3f s after the start (stop asked at 0.15 s)\n", took);
-  EXPECT_LT(took, 0.15 + 5.0);
 }
 
 // ---------------------------------------------------------------------------------------------
