@@ -32,6 +32,8 @@ struct FileBrowser {
             std::string& path);
 };
 
+/// The project's header (name, description, table), the import of a mesh or STEP file as new
+/// parts, and the parts list: each part's name, mesh, initial and assembled poses.
 struct PartsPanel {
   std::string import_path;    ///< Path field of the import.
   int import_unit = 2;        ///< Index into MeshUnits() (mm by default).
