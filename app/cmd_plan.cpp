@@ -85,7 +85,12 @@ int ReportTrajectoryCheck(const LoadedProject& loaded, const Plan& plan, const s
 int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   TaskPlannerOptions options;
   options.project_file = args.project;
-  options.planner = args.planner;
+  const Result<PlannerVariant> variant = ParsePlannerVariant(args.planner);
+  if (!variant) {
+    err << variant.error().message << "\n";
+    return ExitCodeFor(variant.error().code);
+  }
+  options.planner = *variant;
   options.optimize = args.optimize;
   options.memory_limit_mb = args.memory_limit_mb;
   if (args.wrench == "full") {
@@ -118,9 +123,9 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   ctx.set_time_limit_s(time_limit);
   UseLog(ctx, err);
 
-  out << "Planning '" << p.name << "' (" << options.planner << ", seed " << seed << ", wrench "
-      << args.wrench << ", lambda " << Fmt("%g", options.force_scale) << ", time limit "
-      << Fmt("%g", time_limit) << " s"
+  out << "Planning '" << p.name << "' (" << ToString(options.planner) << ", seed " << seed
+      << ", wrench " << args.wrench << ", lambda " << Fmt("%g", options.force_scale)
+      << ", time limit " << Fmt("%g", time_limit) << " s"
       << (args.budget != 1.0 ? ", budget x" + Fmt("%g", args.budget) : std::string()) << ")\n";
   PreprocessOptions pre_options;
   pre_options.project_file = args.project;

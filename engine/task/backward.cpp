@@ -25,6 +25,9 @@
 #include <cstdlib>
 #include <deque>
 #include <map>
+#include <span>
+#include <string>
+#include <vector>
 
 #include "grasp/table_slots.h"
 #include "task/search.h"
@@ -56,85 +59,103 @@ int TaskSearch::GraspClass(int input, int robot, int grasp) {
   return assembly + 2 * (2 * axis + (z[axis] < 0.0 ? 1 : 0));
 }
 
-void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const SymState& s0) {
-  Backward& b = backward_;
-  b = Backward{};
-  b.step = m.step;
-  b.moved = m.moved;
-  b.base = m.base;
-  const int nodes[2] = {m.moved, m.base};
-  const TableSlots& slots = world_.pre->table_slots;
-  const int R = n_robots_;
-  const int nc = fine_ ? 12 : 2;  // grasp classes (assembly or not; fine: times 6 directions)
-  b.classes = nc;
+// The robot-free answers of one milestone's abstraction, by input k (0 moved, 1 base): rest
+// statuses are 0 (the start location) and 1 + p (placement p); grasp classes c < nc.
+struct TaskSearch::BackwardTables {
+  int nodes[2] = {-1, -1};  ///< Node ids of the moved input and the base.
+  int R = 0;                ///< Robots.
+  int nc = 2;               ///< Grasp classes (assembly or not; fine: times 6 directions).
+  Resolution res;           ///< The resolution the abstraction is built at.
+  /// Per input and rest status: its pose.
+  std::vector<std::vector<Iso3>> rest_pose = std::vector<std::vector<Iso3>>(2);
+  /// Robots with the same end effector and the project's wrench limits answer the robot-free
+  /// questions (table clearance, the wrench LP) alike: `same_as[r]` is the first such robot.
+  std::vector<int> same_as;
+  /// pick[k][idx_pick(i, r, c)] (also place for i > 0): some grasp of class c of robot r takes
+  /// input k from rest status i.
+  std::vector<char> pick[2];
+  /// hand[k][idx_hand(r1, c1, r2, c2)]: some grasps of the two classes lie apart.
+  std::vector<char> hand[2];
+  /// rest_asm[i * R + r]: robot r inserts the moved input into the base resting in status i: 0
+  /// no, 1 yes, 2 braced (the assembly LP failed alone: cost 2).
+  std::vector<int> rest_asm;
+  /// air_asm[rm * R + rb]: the moved input held by rm and the base by rb, both with assembly
+  /// grasps, balance the mating wrench.
+  std::vector<char> air_asm;
 
+  int idx_pick(int i, int r, int c) const { return ((i * R) + r) * nc + c; }
+  int idx_hand(int r1, int c1, int r2, int c2) const { return ((r1 * nc + c1) * R + r2) * nc + c2; }
+  int& asm_at(int i, int r) { return rest_asm[static_cast<size_t>(i) * R + r]; }
+  int asm_at(int i, int r) const { return rest_asm[static_cast<size_t>(i) * R + r]; }
+};
+
+std::span<const int> TaskSearch::AbstractGrasps(const BackwardTables& t, int k, int r) {
+  const std::vector<int>& ids = GraspIds(t.nodes[k], r);
+  return std::span<const int>(ids.data(),
+                              std::min<size_t>(ids.size(), static_cast<size_t>(t.res.grasps)));
+}
+
+void TaskSearch::BackwardStatuses(const SymState& s0, BackwardTables& t) {
+  Backward& b = backward_;
+  const TableSlots& slots = world_.pre->table_slots;
   // Rest statuses: 0 = the start location, 1 + p = placement p.
-  std::vector<std::vector<Iso3>> rest_pose(2);
   for (int k = 0; k < 2; ++k) {
-    b.loc0[k] = s0.loc[nodes[k]];
-    const auto& placements = world_.pre->subassemblies[nodes[k]].placements;
+    b.loc0[k] = s0.loc[t.nodes[k]];
+    const auto& placements = world_.pre->subassemblies[t.nodes[k]].placements;
     b.n_place[k] = slots.slots.empty()
                        ? 0
-                       : std::min<int>(res.placements, static_cast<int>(placements.size()));
+                       : std::min<int>(t.res.placements, static_cast<int>(placements.size()));
     b.n_rest[k] = 1 + b.n_place[k];
-    b.n_status[k] = b.n_rest[k] + nc * R;
-    rest_pose[k].push_back(b.loc0[k] >= 0 ? tables_.location(b.loc0[k]).X_WA : Iso3::Identity());
+    b.n_status[k] = b.n_rest[k] + t.nc * t.R;
+    t.rest_pose[k].push_back(b.loc0[k] >= 0 ? tables_.location(b.loc0[k]).X_WA : Iso3::Identity());
     for (int p = 0; p < b.n_place[k]; ++p) {
-      rest_pose[k].push_back(PlacementPose(slots.slots[0], 0.0, placements[p]));
+      t.rest_pose[k].push_back(PlacementPose(slots.slots[0], 0.0, placements[p]));
     }
   }
-  // Robots with the same end effector and the project's wrench limits answer the robot-free
-  // questions (table clearance, the wrench LP) alike: `same_as[r]` is the first such robot.
-  std::vector<int> same_as(R);
-  for (int r = 0; r < R; ++r) {
-    same_as[r] = r;
+  t.same_as.resize(t.R);
+  for (int r = 0; r < t.R; ++r) {
+    t.same_as[r] = r;
     for (int q = 0; q < r; ++q) {
       if (world_.robots[q].grasp_set == world_.robots[r].grasp_set &&
           !world_.project->robots[q].wrench_limits && !world_.project->robots[r].wrench_limits) {
-        same_as[r] = q;
+        t.same_as[r] = q;
         break;
       }
     }
   }
-  auto grasps = [&](int k, int r) {
-    const std::vector<int>& ids = GraspIds(nodes[k], r);
-    return std::span<const int>(ids.data(),
-                                std::min<size_t>(ids.size(), static_cast<size_t>(res.grasps)));
-  };
+}
 
-  // pick[k][i][r][c] (also place for i > 0): some grasp of class c of robot r takes input k
-  // from rest status i.
-  auto idx_pick = [&](int i, int r, int c) { return ((i * R) + r) * nc + c; };
-  std::vector<char> pick[2];
+void TaskSearch::BackwardPicks(BackwardTables& t) {
+  const Backward& b = backward_;
   for (int k = 0; k < 2; ++k) {
-    pick[k].assign(static_cast<size_t>(b.n_rest[k]) * R * nc, 0);
-    for (int r = 0; r < R; ++r) {
-      for (int g : grasps(k, r)) {
+    t.pick[k].assign(static_cast<size_t>(b.n_rest[k]) * t.R * t.nc, 0);
+    for (int r = 0; r < t.R; ++r) {
+      for (int g : AbstractGrasps(t, k, r)) {
         const int c = GraspClass(k, r, g);
-        if (b.loc0[k] >= 0 && !pick[k][idx_pick(0, r, c)] && CheapPick(r, nodes[k], b.loc0[k], g)) {
-          pick[k][idx_pick(0, r, c)] = 1;
+        if (b.loc0[k] >= 0 && !t.pick[k][t.idx_pick(0, r, c)] &&
+            CheapPick(r, t.nodes[k], b.loc0[k], g)) {
+          t.pick[k][t.idx_pick(0, r, c)] = 1;
         }
         for (int p = 0; p < b.n_place[k]; ++p) {
-          char& slot = pick[k][idx_pick(1 + p, r, c)];
-          if (same_as[r] != r) {
-            slot = pick[k][idx_pick(1 + p, same_as[r], c)];
+          char& slot = t.pick[k][t.idx_pick(1 + p, r, c)];
+          if (t.same_as[r] != r) {
+            slot = t.pick[k][t.idx_pick(1 + p, t.same_as[r], c)];
             continue;
           }
           if (slot) continue;
-          const Iso3 target = solver_.GraspTarget(rest_pose[k][1 + p], g);
+          const Iso3 target = solver_.GraspTarget(t.rest_pose[k][1 + p], g);
           if (solver_.ClearOfTable(r, target, solver_.GraspOpening(g))) slot = 1;
         }
       }
     }
   }
-  // hand[k][(r1, c1), (r2, c2)]: some grasps of the two classes lie apart. The answer depends on
-  // the two robots' grasp sets only: computed once per pair of sets.
-  auto idx_hand = [&](int r1, int c1, int r2, int c2) {
-    return ((r1 * nc + c1) * R + r2) * nc + c2;
-  };
-  std::vector<char> hand[2];
+}
+
+void TaskSearch::BackwardHandovers(BackwardTables& t) {
+  // The answer depends on the two robots' grasp sets only: computed once per pair of sets.
+  const int R = t.R, nc = t.nc;
   for (int k = 0; k < 2; ++k) {
-    hand[k].assign(static_cast<size_t>(nc * nc * R * R), 0);
+    t.hand[k].assign(static_cast<size_t>(nc * nc * R * R), 0);
     std::map<std::pair<int, int>, std::vector<char>> by_sets;
     for (int r1 = 0; r1 < R; ++r1) {
       for (int r2 = 0; r2 < R; ++r2) {
@@ -143,39 +164,42 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
             by_sets.try_emplace({world_.robots[r1].grasp_set, world_.robots[r2].grasp_set},
                                 std::vector<char>(static_cast<size_t>(nc * nc), 0));
         std::vector<char>& apart = it->second;
-        for (int g1 : grasps(k, r1)) {
+        for (int g1 : AbstractGrasps(t, k, r1)) {
           if (!fresh) break;
           const int c1 = GraspClass(k, r1, g1);
-          for (int g2 : grasps(k, r2)) {
+          for (int g2 : AbstractGrasps(t, k, r2)) {
             const int c2 = GraspClass(k, r2, g2);
             if (!apart[c1 * nc + c2] && HandsApart(r1, g1, r2, g2)) apart[c1 * nc + c2] = 1;
           }
         }
-        for (int c = 0; c < nc * nc; ++c) hand[k][idx_hand(r1, c / nc, r2, c % nc)] = apart[c];
+        for (int c = 0; c < nc * nc; ++c) t.hand[k][t.idx_hand(r1, c / nc, r2, c % nc)] = apart[c];
       }
     }
   }
-  // rest_asm[i][r]: robot r can insert the moved input (assembly grasp) into the base resting in
-  // status i: the moved input stays above the table, the gripper clears it, and (budgeted) the
-  // assembly LP holds for some grasp, alone or with a brace (cost 2 then).
+}
+
+void TaskSearch::BackwardRestAssembly(const Milestone& m, BackwardTables& t) {
+  // The moved input stays above the table, the gripper clears it, and (budgeted) the assembly
+  // LP holds for some grasp, alone or with a brace (cost 2 then).
+  const Backward& b = backward_;
+  const int R = t.R;
   const bool wrench = options_.wrench_mode != MatingWrenchMode::kNone;
   long long lp_budget = 150;
-  std::vector<int> rest_asm(static_cast<size_t>(b.n_rest[1]) * R, 0);  // 0 no, 1 ok, 2 braced
-  auto asm_at = [&](int i, int r) -> int& { return rest_asm[static_cast<size_t>(i) * R + r]; };
+  t.rest_asm.assign(static_cast<size_t>(b.n_rest[1]) * R, 0);
   for (int i = 0; i < b.n_rest[1]; ++i) {
     if (i == 0 && b.loc0[1] < 0) continue;
-    const Iso3& X = rest_pose[1][i];
+    const Iso3& X = t.rest_pose[1][i];
     const double low = LowestPoint(world_, m.moved, X);
     if (low < world_.table_top - 1e-3) continue;
     const bool m_rests = std::abs(low - world_.table_top) <= 2e-3;
     const int loc = i == 0 ? b.loc0[1] : tables_.PlacedLocation(m.base, i - 1, 0, 0, X);
     for (int r = 0; r < R; ++r) {
       int best = 0;
-      if (i > 0 && same_as[r] != r) {  // a placement: wherever on the table, the same answers
-        asm_at(i, r) = asm_at(i, same_as[r]);
+      if (i > 0 && t.same_as[r] != r) {  // a placement: wherever on the table, the same answers
+        t.asm_at(i, r) = t.asm_at(i, t.same_as[r]);
         continue;
       }
-      for (int g : grasps(0, r)) {
+      for (int g : AbstractGrasps(t, 0, r)) {
         if (best == 1) break;
         if (!AssemblyGrasp(0, r, g)) continue;
         const Iso3 target = solver_.GraspTarget(X, g);
@@ -193,20 +217,24 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
                    ? 1
                    : 2;
       }
-      asm_at(i, r) = best;
+      t.asm_at(i, r) = best;
     }
   }
-  // air_asm[r_m][r_b]: the moved input held by r_m and the base by r_b, both with assembly
-  // grasps, balance the mating wrench in some orientation (budgeted).
-  std::vector<char> air_asm(static_cast<size_t>(R * R), 0);
+}
+
+void TaskSearch::BackwardAirAssembly(const Milestone& m, BackwardTables& t) {
+  // Budgeted: some orientation balances the mating wrench.
+  const int R = t.R;
+  const bool wrench = options_.wrench_mode != MatingWrenchMode::kNone;
+  t.air_asm.assign(static_cast<size_t>(R * R), 0);
   long long air_budget = 12;
   for (int rm = 0; rm < R; ++rm) {
     for (int rb = 0; rb < R; ++rb) {
       if (rm == rb) continue;
-      char& out = air_asm[rm * R + rb];
-      for (int gm : grasps(0, rm)) {
+      char& out = t.air_asm[rm * R + rb];
+      for (int gm : AbstractGrasps(t, 0, rm)) {
         if (out || !AssemblyGrasp(0, rm, gm)) continue;
-        for (int gb : grasps(1, rb)) {
+        for (int gb : AbstractGrasps(t, 1, rb)) {
           if (!AssemblyGrasp(1, rb, gb)) continue;
           if (!wrench || --air_budget < 0) {
             out = 1;
@@ -223,7 +251,11 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
       }
     }
   }
+}
 
+void TaskSearch::BackwardDistances(const BackwardTables& t) {
+  Backward& b = backward_;
+  const int R = t.R, nc = t.nc;
   // The abstract graph: states (status of the moved input, status of the base); edges reversed.
   const int NM = b.n_status[0], NB = b.n_status[1];
   const int N = NM * NB;
@@ -250,18 +282,18 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
           for (int r = 0; r < R; ++r) {
             if (r == other_holder) continue;
             for (int c = 0; c < nc; ++c) {
-              if (pick[k][idx_pick(s, r, c)]) add(b.n_rest[k] + nc * r + c);
+              if (t.pick[k][t.idx_pick(s, r, c)]) add(b.n_rest[k] + nc * r + c);
             }
           }
         } else {
           const int r = (s - b.n_rest[k]) / nc, c = (s - b.n_rest[k]) % nc;
           for (int p = 0; p < b.n_place[k]; ++p) {
-            if (pick[k][idx_pick(1 + p, r, c)]) add(1 + p);
+            if (t.pick[k][t.idx_pick(1 + p, r, c)]) add(1 + p);
           }
           for (int r2 = 0; r2 < R; ++r2) {
             if (r2 == r || r2 == other_holder) continue;
             for (int c2 = 0; c2 < nc; ++c2) {
-              if (hand[k][idx_hand(r, c, r2, c2)]) add(b.n_rest[k] + nc * r2 + c2);
+              if (t.hand[k][t.idx_hand(r, c, r2, c2)]) add(b.n_rest[k] + nc * r2 + c2);
             }
           }
         }
@@ -269,9 +301,9 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
       // Assemble: the moved input held with an assembly grasp.
       if (rm >= 0 && (sm - b.n_rest[0]) % nc % 2 == 1) {
         if (rb >= 0) {
-          if ((sb - b.n_rest[1]) % nc % 2 == 1 && air_asm[rm * R + rb]) goal_cost[from] = 1;
+          if ((sb - b.n_rest[1]) % nc % 2 == 1 && t.air_asm[rm * R + rb]) goal_cost[from] = 1;
         } else if (sb > 0 || b.loc0[1] >= 0) {
-          const int ra = asm_at(sb, rm);
+          const int ra = t.asm_at(sb, rm);
           if (ra > 0) goal_cost[from] = ra;
         }
       }
@@ -295,68 +327,91 @@ void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const 
       }
     }
   }
+}
 
-  // Why the assembly is out of reach from the start, in words.
-  const int start = BackwardDistance(s0);
-  if (start >= kFar) {
-    const std::string& mn = world_.tree->nodes[m.moved].name;
-    const std::string& bn = world_.tree->nodes[m.base].name;
-    int n_asm = 0, n_all = 0;
-    bool base_support = false, m_pick = b.loc0[0] < 0;
-    for (int r = 0; r < R; ++r) {
-      for (int g : grasps(0, r)) {
-        ++n_all;
-        n_asm += AssemblyGrasp(0, r, g) ? 1 : 0;
-      }
-      for (int i = 0; i < b.n_rest[1]; ++i) base_support |= asm_at(i, r) > 0;
-      for (int q = 0; q < R; ++q) base_support |= air_asm[r * R + q] != 0;
-      for (int c = 0; c < nc; ++c) m_pick |= pick[0][idx_pick(0, r, c)] != 0;
+std::string TaskSearch::BackwardWhy(const Milestone& m, const BackwardTables& t) {
+  const Backward& b = backward_;
+  const std::string& mn = world_.tree->nodes[m.moved].name;
+  const std::string& bn = world_.tree->nodes[m.base].name;
+  int n_asm = 0, n_all = 0;
+  bool base_support = false, m_pick = b.loc0[0] < 0;
+  for (int r = 0; r < t.R; ++r) {
+    for (int g : AbstractGrasps(t, 0, r)) {
+      ++n_all;
+      n_asm += AssemblyGrasp(0, r, g) ? 1 : 0;
     }
-    if (n_all == 0) {
-      b.why = "no robot has a grasp of '" + mn + "'";
-    } else if (n_asm == 0) {
-      b.why = "none of the " + std::to_string(n_all) + " grasps of '" + mn +
-              "' leaves the gripper clear of '" + bn + "' at the mating pose";
-    } else if (!base_support) {
-      b.why = "'" + bn + "' offers no support for the insertion: resting in none of its " +
-              std::to_string(b.n_place[1]) + " placements considered does an assembly grasp of '" +
-              mn + "' stay clear of the table (or balance the mating wrench), and held by one " +
-              "robot no pair of assembly grasps balances it";
-    } else if (!m_pick) {
-      b.why = PickCensus(m.moved, b.loc0[0], res.grasps);
-    } else {
-      b.why = "no sequence of picks, handovers and set-downs gives a robot one of the " +
-              std::to_string(n_asm) + " assembly grasps of '" + mn + "' (of " +
-              std::to_string(n_all) + ") while '" + bn + "' is supported";
-    }
+    for (int i = 0; i < b.n_rest[1]; ++i) base_support |= t.asm_at(i, r) > 0;
+    for (int q = 0; q < t.R; ++q) base_support |= t.air_asm[r * t.R + q] != 0;
+    for (int c = 0; c < t.nc; ++c) m_pick |= t.pick[0][t.idx_pick(0, r, c)] != 0;
   }
-  if (ctx_.Logs("task")) {
-    for (int k = 0; k < 2; ++k) {
-      std::string line = StrFormat("backward: input %d '%s' loc0 %d, %d placements; per robot: ",
-                                   k, world_.tree->nodes[nodes[k]].name.c_str(), b.loc0[k],
-                                   b.n_place[k]);
-      for (int r = 0; r < R; ++r) {
-        int n_asm = 0, n = 0;
-        for (int g : grasps(k, r)) {
-          ++n;
-          n_asm += AssemblyGrasp(k, r, g) ? 1 : 0;
-        }
-        int n_pick = 0;
-        for (int c = 0; c < nc; ++c) n_pick += pick[k][idx_pick(0, r, c)];
-        line += StrFormat("r%d %d/%d asm, pick0 %d classes; ", r, n_asm, n, n_pick);
+  if (n_all == 0) return "no robot has a grasp of '" + mn + "'";
+  if (n_asm == 0) {
+    return "none of the " + std::to_string(n_all) + " grasps of '" + mn +
+           "' leaves the gripper clear of '" + bn + "' at the mating pose";
+  }
+  if (!base_support) {
+    return "'" + bn + "' offers no support for the insertion: resting in none of its " +
+           std::to_string(b.n_place[1]) + " placements considered does an assembly grasp of '" +
+           mn + "' stay clear of the table (or balance the mating wrench), and held by one " +
+           "robot no pair of assembly grasps balances it";
+  }
+  if (!m_pick) return PickCensus(m.moved, b.loc0[0], t.res.grasps);
+  return "no sequence of picks, handovers and set-downs gives a robot one of the " +
+         std::to_string(n_asm) + " assembly grasps of '" + mn + "' (of " + std::to_string(n_all) +
+         ") while '" + bn + "' is supported";
+}
+
+void TaskSearch::LogBackward(const BackwardTables& t) {
+  const Backward& b = backward_;
+  for (int k = 0; k < 2; ++k) {
+    std::string line =
+        StrFormat("backward: input %d '%s' loc0 %d, %d placements; per robot: ", k,
+                  world_.tree->nodes[t.nodes[k]].name.c_str(), b.loc0[k], b.n_place[k]);
+    for (int r = 0; r < t.R; ++r) {
+      int n_asm = 0, n = 0;
+      for (int g : AbstractGrasps(t, k, r)) {
+        ++n;
+        n_asm += AssemblyGrasp(k, r, g) ? 1 : 0;
       }
-      ctx_.Log("task", line);
+      int n_pick = 0;
+      for (int c = 0; c < t.nc; ++c) n_pick += t.pick[k][t.idx_pick(0, r, c)];
+      line += StrFormat("r%d %d/%d asm, pick0 %d classes; ", r, n_asm, n, n_pick);
     }
-    std::string line = "backward: rest_asm:";
-    for (int i = 0; i < b.n_rest[1]; ++i) {
-      line += " [";
-      for (int r = 0; r < R; ++r) line += std::to_string(asm_at(i, r));
-      line += "]";
-    }
-    line += " air_asm:";
-    for (int v : air_asm) line += std::to_string(v);
     ctx_.Log("task", line);
   }
+  std::string line = "backward: rest_asm:";
+  for (int i = 0; i < b.n_rest[1]; ++i) {
+    line += " [";
+    for (int r = 0; r < t.R; ++r) line += std::to_string(t.asm_at(i, r));
+    line += "]";
+  }
+  line += " air_asm:";
+  for (int v : t.air_asm) line += std::to_string(v);
+  ctx_.Log("task", line);
+}
+
+void TaskSearch::BuildBackward(const Milestone& m, const Resolution& res, const SymState& s0) {
+  Backward& b = backward_;
+  b = Backward{};
+  b.step = m.step;
+  b.moved = m.moved;
+  b.base = m.base;
+  BackwardTables t;
+  t.nodes[0] = m.moved;
+  t.nodes[1] = m.base;
+  t.R = n_robots_;
+  t.nc = fine_ ? 12 : 2;  // grasp classes (assembly or not; fine: times 6 directions)
+  t.res = res;
+  b.classes = t.nc;
+  BackwardStatuses(s0, t);
+  BackwardPicks(t);
+  BackwardHandovers(t);
+  BackwardRestAssembly(m, t);
+  BackwardAirAssembly(m, t);
+  BackwardDistances(t);
+  // Why the assembly is out of reach from the start, in words.
+  if (BackwardDistance(s0) >= kFar) b.why = BackwardWhy(m, t);
+  if (ctx_.Logs("task")) LogBackward(t);
 }
 
 int TaskSearch::BackwardDistance(const SymState& s) {

@@ -90,10 +90,10 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
                  : search.FillWindow(i, std::vector<int>(order.begin() + i, order.begin() + i + n),
                                      next, s, c, window);
       if (debug) {
-        ctx.Log("task", StrFormat("improve: window %d+%d (cost %d, bound %d): %s %zu at %.2f s",
-                                  i, n, window_cost, window.max_cost, w.ok ? "found" : "none",
-                                  w.actions.size(),
-                                  std::chrono::duration<double>(Clock::now() - start).count()));
+        ctx.Log("task",
+                StrFormat("improve: window %d+%d (cost %d, bound %d): %s %zu at %.2f s", i, n,
+                          window_cost, window.max_cost, w.ok ? "found" : "none", w.actions.size(),
+                          std::chrono::duration<double>(Clock::now() - start).count()));
       }
       if (w.stopped || w.out_of_memory) return false;
       if (!w.ok) continue;
@@ -178,21 +178,8 @@ Result<void> CheckInsertionPaths(const Project& project, const ProjectCheck& che
   return {};
 }
 
-}  // namespace
-
-Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const Preprocessed& pre,
-                      const TaskPlannerOptions& options, RunContext& ctx) {
-  // The planner judges every insertion path against the meshes before it plans (its own sweep
-  // of each step, whatever validation said): no plan drives one input through the other.
-  if (auto free = CheckInsertionPaths(project, check); !free) return std::unexpected(free.error());
-  const auto start = Clock::now();
-  static const std::set<std::string> kVariants = {"wrap",     "optimistic", "flat",
-                                                  "counting", "exact",      "fine"};
-  if (!kVariants.contains(options.planner)) {
-    return Fail(ErrorCode::kInvalidInput,
-                "planner: unknown variant '" + options.planner +
-                    "' (known: wrap, optimistic, flat, counting, exact, fine)");
-  }
+// PlanTask's options out of range.
+Result<void> CheckOptions(const TaskPlannerOptions& options) {
   if (!(options.force_scale >= 0.0) || !std::isfinite(options.force_scale)) {
     return Fail(ErrorCode::kInvalidInput, "planner: --force-scale must be finite and >= 0");
   }
@@ -200,35 +187,22 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
       options.max_nodes < 100 || !(options.min_clearance_m >= 0.0) || options.memory_limit_mb < 1) {
     return Fail(ErrorCode::kInvalidInput, "planner: options out of range");
   }
-  auto world_or = BuildTaskWorld(project, check, pre, options.project_file);
-  if (!world_or) return std::unexpected(world_or.error());
-  const TaskWorld& world = *world_or;
-  CellOptions cell_options;
-  cell_options.objects_touch_table = false;
-  auto cell = Cell::Build(world.cell_def, cell_options);
-  if (!cell) return Fail(ErrorCode::kInvalidInput, "planner: " + cell.error().message);
+  return {};
+}
 
-  TaskTables tables;
-  TaskCounters counters;
-  KeyframeSolver solver(world, tables, options, std::move(*cell), counters);
-  solver.set_log(&ctx);
-  const std::uint64_t seed = ctx.rng()();
-  const bool widen = options.widen.value_or(project.planner.widen_grasps);
-  TaskSearch search(world, tables, solver, options, ctx, seed, widen);
-
-  Plan plan;
+// The initial state: every part resting at its initial pose, robots at home; the plan gets the
+// names of robots, parts and nodes and the initial cell.
+void StartTask(const Project& project, const TaskWorld& world, TaskTables& tables, SymState& s0,
+               ContState& c0, Plan& plan) {
   plan.project = project.name;
   for (const Robot& r : project.robots) plan.robots.push_back(r.name);
   for (const Part& p : project.parts) plan.parts.push_back(p.name);
   for (const AssemblyNode& n : world.tree->nodes) plan.nodes.push_back(n.name);
 
-  // The initial state: every part resting at its initial pose, robots at home.
   const int n_robots = static_cast<int>(world.robots.size());
-  SymState s0;
   s0.loc.assign(world.num_nodes, kInactive);
   s0.held.assign(n_robots, -1);
   s0.grasp.assign(n_robots, -1);
-  ContState c0;
   c0.X_WA.assign(world.num_nodes, Iso3::Identity());
   for (int p = 0; p < world.num_parts; ++p) {
     s0.loc[p] = static_cast<int16_t>(tables.InitialLocation(p, world.initial_X_WA[p]));
@@ -237,20 +211,30 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   for (const TaskRobot& r : world.robots) c0.q.push_back(r.home);
   plan.initial.q = c0.q;
   for (int p = 0; p < world.num_parts; ++p) plan.initial.objects.push_back({p, c0.X_WA[p], true});
+}
 
-  // Milestones in the DAG's topological order, with backtracking; Flat lazy: one search.
-  const std::vector<int>& order = world.tree->step_order;
-  plan.milestone_steps = order;
+// Where the milestone loop ended.
+struct MilestoneRun {
+  std::vector<MilestoneResult> results;  ///< Per milestone (Flat lazy: one for the whole task).
+  int reached = 0;             ///< Milestones filled in a row from the start; K when solved.
+  int backtracks = 0;          ///< Milestone re-plans.
+  std::string failure;         ///< Why not solved, in words.
+  PlanFailure detail;          ///< The failure as data, following `failure`.
+  bool stopped = false;        ///< Cancelled or out of time.
+  bool out_of_memory = false;  ///< Stopped by the memory limit.
+};
+
+// The milestones in the DAG's topological order `order` from (s0, c0), with backtracking; Flat
+// lazy: one search.
+MilestoneRun FillMilestones(TaskSearch& search, const TaskWorld& world,
+                            const TaskPlannerOptions& options, const std::vector<int>& order,
+                            bool flat, const SymState& s0, const ContState& c0, RunContext& ctx) {
   const int K = static_cast<int>(order.size());
-  const bool flat = options.planner == "flat";
-  std::vector<MilestoneResult> results(flat ? 1 : K);
+  MilestoneRun run;
+  run.results.resize(flat ? 1 : K);
+  std::vector<MilestoneResult>& results = run.results;
   std::vector<std::set<std::uint64_t>> excluded(K);
-  int k = 0;
-  int backtracks = 0;
-  std::string failure;
-  PlanFailure detail;  // the failure as data, following `failure`
-  bool stopped = false;
-  bool out_of_memory = false;
+  int& k = run.reached;
   while (k < K) {
     const std::string words = flat
                                   ? "the whole task (flat)"
@@ -273,42 +257,36 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
       continue;
     }
     if (r.stopped || r.out_of_memory) {
-      stopped = r.stopped;
-      out_of_memory = r.out_of_memory;
-      failure = words + " was being planned; checks that failed most: " + r.failure;
-      detail = MilestoneFailure(flat ? -1 : k, flat ? -1 : order[k], r);
-      if (out_of_memory) {
-        failure = "out of memory (the search held more than the " +
-                  std::to_string(options.memory_limit_mb) + " MiB limit) while " + failure;
+      run.stopped = r.stopped;
+      run.out_of_memory = r.out_of_memory;
+      run.failure = words + " was being planned; checks that failed most: " + r.failure;
+      run.detail = MilestoneFailure(flat ? -1 : k, flat ? -1 : order[k], r);
+      if (run.out_of_memory) {
+        run.failure = "out of memory (the search held more than the " +
+                      std::to_string(options.memory_limit_mb) + " MiB limit) while " + run.failure;
       }
       break;
     }
-    failure = r.failure;
-    detail = MilestoneFailure(flat ? -1 : k, flat ? -1 : order[k], r);
-    ctx.Log("task", failure);
-    if (!flat && k > 0 && backtracks < options.max_backtracks) {
+    run.failure = r.failure;
+    run.detail = MilestoneFailure(flat ? -1 : k, flat ? -1 : order[k], r);
+    ctx.Log("task", run.failure);
+    if (!flat && k > 0 && run.backtracks < options.max_backtracks) {
       excluded[k - 1].insert(results[k - 1].end.Hash());
       excluded[k].clear();
       --k;
-      ++backtracks;
+      ++run.backtracks;
       continue;
     }
     break;
   }
-  const double t_first = std::chrono::duration<double>(Clock::now() - start).count();
-  std::vector<std::pair<double, int>> history;
-  double t_opt = 0.0;
-  if (k == K) {
-    history.push_back({t_first, CostOf(results, 0, static_cast<int>(results.size()))});
-    if (options.optimize && !flat) {
-      Improve(search, order, s0, c0, results, ctx, start, history);
-      t_opt = std::chrono::duration<double>(Clock::now() - start).count() - t_first;
-    }
-  }
-  if (ctx.cancelled()) return Fail(ErrorCode::kCancelled, "planner: cancelled");
+  return run;
+}
 
-  PlanStats& st = plan.stats;
-  st.planner = options.planner;
+// The run's counters and stage times into the plan's stats (and ctx's stage times).
+void CountSearch(const Project& project, const Preprocessed& pre, const TaskPlannerOptions& options,
+                 const TaskSearch& search, const TaskCounters& counters, RunContext& ctx,
+                 PlanStats& st) {
+  st.planner = std::string(ToString(options.planner));
   st.seed = project.planner.seed;
   st.wrench_mode = ModeName(options.wrench_mode);
   st.force_scale = options.force_scale;
@@ -329,42 +307,128 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   st.t_bwd_s = search.backward_seconds();
   st.t_fwd_s =
       std::max(0.0, search.search_seconds() - st.t_bwd_s - counters.t_ik_s - counters.t_lp_s);
-  st.milestones = K;
-  st.backtracks = backtracks;
   st.widenings = search.widenings();
   ctx.AddTime("ik", st.t_ik_s);
   ctx.AddTime("lp", st.t_lp_s);
   ctx.AddTime("fwd", st.t_fwd_s);
   ctx.AddTime("bwd", st.t_bwd_s);
+}
+
+// The solved run's actions into the plan, milestone after milestone; Flat lazy finds its
+// milestones after the fact: the steps in the order the search assembled them.
+void CollectActions(const std::vector<MilestoneResult>& results, bool flat, int K, Plan& plan) {
+  for (const MilestoneResult& r : results) {
+    plan.actions.insert(plan.actions.end(), r.actions.begin(), r.actions.end());
+  }
+  if (flat) {
+    plan.milestone_steps.clear();
+    for (PlanAction& a : plan.actions) {
+      a.milestone = static_cast<int>(plan.milestone_steps.size());
+      if (a.type == ActionType::kAssemble) plan.milestone_steps.push_back(a.objects.back());
+    }
+    for (PlanAction& a : plan.actions) a.milestone = std::min(a.milestone, K - 1);
+  }
+}
+
+}  // namespace
+
+std::string_view ToString(PlannerVariant variant) {
+  switch (variant) {
+    case PlannerVariant::kWrap:
+      return "wrap";
+    case PlannerVariant::kOptimistic:
+      return "optimistic";
+    case PlannerVariant::kFlat:
+      return "flat";
+    case PlannerVariant::kCounting:
+      return "counting";
+    case PlannerVariant::kExact:
+      return "exact";
+    case PlannerVariant::kFine:
+      return "fine";
+  }
+  return "?";
+}
+
+Result<PlannerVariant> ParsePlannerVariant(std::string_view name) {
+  for (PlannerVariant v :
+       {PlannerVariant::kWrap, PlannerVariant::kOptimistic, PlannerVariant::kFlat,
+        PlannerVariant::kCounting, PlannerVariant::kExact, PlannerVariant::kFine}) {
+    if (ToString(v) == name) return v;
+  }
+  return Fail(ErrorCode::kInvalidInput,
+              "planner: unknown variant '" + std::string(name) +
+                  "' (known: wrap, optimistic, flat, counting, exact, fine)");
+}
+
+Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const Preprocessed& pre,
+                      const TaskPlannerOptions& options, RunContext& ctx) {
+  // The planner judges every insertion path against the meshes before it plans (its own sweep
+  // of each step, whatever validation said): no plan drives one input through the other.
+  if (auto free = CheckInsertionPaths(project, check); !free) return std::unexpected(free.error());
+  const auto start = Clock::now();
+  if (auto valid = CheckOptions(options); !valid) return std::unexpected(valid.error());
+  auto world_or = BuildTaskWorld(project, check, pre, options.project_file);
+  if (!world_or) return std::unexpected(world_or.error());
+  const TaskWorld& world = *world_or;
+  CellOptions cell_options;
+  cell_options.objects_touch_table = false;
+  auto cell = Cell::Build(world.cell_def, cell_options);
+  if (!cell) return Fail(ErrorCode::kInvalidInput, "planner: " + cell.error().message);
+
+  TaskTables tables;
+  TaskCounters counters;
+  KeyframeSolver solver(world, tables, options, std::move(*cell), counters);
+  solver.set_log(&ctx);
+  const std::uint64_t seed = ctx.rng()();
+  const bool widen = options.widen.value_or(project.planner.widen_grasps);
+  TaskSearch search(world, tables, solver, options, ctx, seed, widen);
+
+  Plan plan;
+  SymState s0;
+  ContState c0;
+  StartTask(project, world, tables, s0, c0, plan);
+
+  const std::vector<int>& order = world.tree->step_order;
+  plan.milestone_steps = order;
+  const int K = static_cast<int>(order.size());
+  const bool flat = options.planner == PlannerVariant::kFlat;
+  MilestoneRun run = FillMilestones(search, world, options, order, flat, s0, c0, ctx);
+  const double t_first = std::chrono::duration<double>(Clock::now() - start).count();
+  std::vector<std::pair<double, int>> history;
+  double t_opt = 0.0;
+  if (run.reached == K) {
+    history.push_back({t_first, CostOf(run.results, 0, static_cast<int>(run.results.size()))});
+    if (options.optimize && !flat) {
+      Improve(search, order, s0, c0, run.results, ctx, start, history);
+      t_opt = std::chrono::duration<double>(Clock::now() - start).count() - t_first;
+    }
+  }
+  if (ctx.cancelled()) return Fail(ErrorCode::kCancelled, "planner: cancelled");
+
+  PlanStats& st = plan.stats;
+  CountSearch(project, pre, options, search, counters, ctx, st);
+  st.milestones = K;
+  st.backtracks = run.backtracks;
   st.t_init_s = t_first;
   st.t_opt_s = t_opt;
   st.cost_history = history;
-  st.out_of_memory = out_of_memory;
-  if (k == K) {
+  st.out_of_memory = run.out_of_memory;
+  if (run.reached == K) {
     st.solved = true;
-    for (const MilestoneResult& r : results) {
-      plan.actions.insert(plan.actions.end(), r.actions.begin(), r.actions.end());
-    }
-    if (flat) {
-      // Milestones after the fact: the steps in the order the search assembled them.
-      plan.milestone_steps.clear();
-      for (PlanAction& a : plan.actions) {
-        a.milestone = static_cast<int>(plan.milestone_steps.size());
-        if (a.type == ActionType::kAssemble) plan.milestone_steps.push_back(a.objects.back());
-      }
-      for (PlanAction& a : plan.actions) a.milestone = std::min(a.milestone, K - 1);
-    }
+    CollectActions(run.results, flat, K, plan);
     st.cost = static_cast<int>(plan.actions.size());
     st.first_cost = history.front().second;
   } else {
     st.solved = false;
-    if (stopped) {
+    std::string failure = std::move(run.failure);
+    if (run.stopped) {
       failure = (ctx.timed_out() ? "time limit reached while " : "stopped while ") + failure;
     }
     if (failure.empty()) failure = "no plan";
     st.failure = failure;
-    detail.text = failure;
-    st.failure_detail = std::move(detail);
+    run.detail.text = failure;
+    st.failure_detail = std::move(run.detail);
   }
   return plan;
 }

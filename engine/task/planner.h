@@ -22,8 +22,10 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 
 #include "core/result.h"
 #include "core/run_context.h"
@@ -35,13 +37,28 @@
 
 namespace wrap {
 
+/// The planner variant: the paper's comparison rows.
+enum class PlannerVariant {
+  kWrap,        ///< "wrap": WRAP's backward abstract heuristic (the default).
+  kOptimistic,  ///< "optimistic": assembly grasps chosen first, like Dogar et al.
+  kFlat,        ///< "flat": Flat lazy, one search over the whole task, no milestones.
+  kCounting,    ///< "counting": Milestones + counting.
+  kExact,       ///< "exact": wrap with weight-one fills (f = g + h).
+  kFine,        ///< "fine": wrap with a finer projection (grasp classes split by approach).
+};
+
+/// The variant's name as the CLI (`--planner`), the GUI, the bench harness and the plan's JSON
+/// (PlanStats::planner) spell it, e.g. "counting".
+std::string_view ToString(PlannerVariant variant);
+
+/// The variant named `name` (ToString's words). Fails with kInvalidInput for an unknown name,
+/// listing the known ones.
+Result<PlannerVariant> ParsePlannerVariant(std::string_view name);
+
 /// Options of PlanTask.
 struct TaskPlannerOptions {
-  /// Variant, the paper's comparison rows: "wrap" (backward abstract heuristic), "optimistic"
-  /// (assembly grasps chosen first, like Dogar et al.), "flat" (Flat lazy: one search, no
-  /// milestones), "counting" (Milestones + counting), "exact" (wrap with weight-one fills),
-  /// "fine" (wrap with a finer projection: grasp classes split by approach direction).
-  std::string planner = "wrap";
+  /// Variant, the paper's comparison rows (PlannerVariant).
+  PlannerVariant planner = PlannerVariant::kWrap;
   /// Anytime plan improvement after the first plan (large neighbourhood search) until the time
   /// limit of the RunContext or until windows of the whole horizon bring nothing more.
   bool optimize = false;
@@ -69,10 +86,9 @@ struct TaskPlannerOptions {
 /// Returns a plan with stats.solved = true, or with solved = false and stats.failure saying which
 /// milestone failed and why (the gate that failed most, for which robots and grasps) when none
 /// is found within the search space or the time limit of `ctx` (stats.failure then says so).
-/// Fails with kInvalidInput for an unknown variant or options out of range or a project the
-/// planner cannot set up (a robot model that does not load), kCancelled when ctx is cancelled.
-/// Deterministic: same inputs and ctx seed, same plan. Adds its stage times to ctx ("bwd", "lp",
-/// "fwd", "ik").
+/// Fails with kInvalidInput for options out of range or a project the planner cannot set up (a
+/// robot model that does not load), kCancelled when ctx is cancelled. Deterministic: same inputs
+/// and ctx seed, same plan. Adds its stage times to ctx ("bwd", "lp", "fwd", "ik").
 [[nodiscard]] Result<Plan> PlanTask(const Project& project, const ProjectCheck& check,
                                     const Preprocessed& pre, const TaskPlannerOptions& options,
                                     RunContext& ctx);

@@ -2,7 +2,9 @@
 // backward abstraction, or counting for the "counting" variant and plan improvement): a lazy
 // weighted best-first search over the symbolic state of one assembly step, edges validated by
 // the KeyframeSolver only on the best candidate plan, effort levels for suspended edges and
-// widening of the grasp and placement subsets.
+// widening of the grasp and placement subsets. Its sources: search.cpp (milestones, heuristic),
+// successors.cpp (the actions of a state), cheap_checks.cpp, lazy_search.cpp (best-first search,
+// edge validation, commits), backward.cpp (WRAP's heuristic), variants.cpp, search_failure.cpp.
 #pragma once
 
 #include <array>
@@ -10,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -61,10 +64,10 @@ struct MilestoneResult {
   std::vector<PlanAction> actions;  ///< The validated actions.
   /// The state after each action (plan improvement splits a window's actions by milestone).
   std::vector<std::pair<SymState, ContState>> after;
-  SymState end;                ///< Symbolic state at its end.
-  ContState end_c;             ///< Continuous state at its end.
-  bool out_of_memory = false;  ///< Stopped by TaskPlannerOptions::memory_limit_mb.
-  std::string failure;         ///< Why not, when !ok.
+  SymState end;                    ///< Symbolic state at its end.
+  ContState end_c;                 ///< Continuous state at its end.
+  bool out_of_memory = false;      ///< Stopped by TaskPlannerOptions::memory_limit_mb.
+  std::string failure;             ///< Why not, when !ok.
   std::vector<FailureCase> cases;  ///< The same as data, blocker first (FailureCase::scene: the
                                    ///< tried object moved, robots as at the milestone's start).
   FailureScene start;              ///< The cell at the milestone's start (failure record).
@@ -152,6 +155,17 @@ class TaskSearch {
     TaskAction a;
   };
   enum class SearchStatus { kFound, kExhausted, kNodeLimit, kStopped, kOutOfMemory };
+  /// Actions of a state with the states they lead to.
+  using SuccessorList = std::vector<std::pair<TaskAction, SymState>>;
+  /// A validated state of a fill's committed prefix (Rounds), with the edge into it.
+  struct Committed {
+    SymState s;
+    ContState c;
+    std::uint64_t entering_edge = 0;
+  };
+  /// How the validation of a candidate plan ended: every edge held, one failed, the run was
+  /// stopped, or the fill gives up (its failure limit, or Optimistic's bad target).
+  enum class CandidateStatus { kValid, kInvalid, kStopped, kGiveUp };
 
   Resolution ResolutionAt(int level) const;
   const std::vector<int>& GraspIds(int node, int robot);
@@ -160,6 +174,26 @@ class TaskSearch {
   /// resolution `res` from the start state s0, and its distance of a forward state.
   void BuildBackward(const Milestone& m, const Resolution& res, const SymState& s0);
   int BackwardDistance(const SymState& s);
+  /// BuildBackward's robot-free tables of one milestone (backward.cpp).
+  struct BackwardTables;
+  /// The first `t.res.grasps` grasp ids of input `k` for robot `r`.
+  std::span<const int> AbstractGrasps(const BackwardTables& t, int k, int r);
+  /// The inputs' rest statuses (start location, placements) and their poses; robots alike.
+  void BackwardStatuses(const SymState& s0, BackwardTables& t);
+  /// Which grasp classes pick (or place) each input in each rest status.
+  void BackwardPicks(BackwardTables& t);
+  /// Which pairs of grasp classes can hand each input over.
+  void BackwardHandovers(BackwardTables& t);
+  /// Which robots insert the moved input into the base resting in each status.
+  void BackwardRestAssembly(const Milestone& m, BackwardTables& t);
+  /// Which pairs of robots assemble with both inputs in the air.
+  void BackwardAirAssembly(const Milestone& m, BackwardTables& t);
+  /// The abstract graph's distances to the assembly (backward_.dist), breadth-first.
+  void BackwardDistances(const BackwardTables& t);
+  /// Why the assembly is out of reach from the milestone's start, in words.
+  std::string BackwardWhy(const Milestone& m, const BackwardTables& t);
+  /// The tables in the "task" log.
+  void LogBackward(const BackwardTables& t);
   /// The class of grasp id `grasp` of input `input` held by `robot` in the abstraction: assembly
   /// grasp or not (bit 0) and, for the fine projection, the approach direction in the object's
   /// frame (one of six).
@@ -168,11 +202,30 @@ class TaskSearch {
   /// assembly grasp: the gripper clears the other input at the mating pose. Cached.
   bool AssemblyGrasp(int input, int robot, int grasp);
   bool IsGoal(const SymState& s, const Milestone& m, const std::set<std::uint64_t>& excluded) const;
-  void Successors(const SymState& s, const Milestone& m, const Resolution& res,
-                  std::vector<std::pair<TaskAction, SymState>>& out);
+  /// The actions of `s` within milestone `m` at resolution `res` that pass their cheap checks
+  /// (successors.cpp), each with its next state.
+  void Successors(const SymState& s, const Milestone& m, const Resolution& res, SuccessorList& out);
   /// Flat lazy: the successors of every step whose inputs exist (and of the final product).
-  void FlatSuccessors(const SymState& s, const Resolution& res,
-                      std::vector<std::pair<TaskAction, SymState>>& out);
+  void FlatSuccessors(const SymState& s, const Resolution& res, SuccessorList& out);
+  /// Appends action `a` of `s` with the state it leads to.
+  void Push(const SymState& s, const TaskAction& a, SuccessorList& out) const;
+  /// Free `robot` picks resting `node` with one of `grasps`.
+  void PickSuccessors(const SymState& s, int robot, int node, std::span<const int> grasps,
+                      SuccessorList& out);
+  /// Free `robot` adds a grasp on `node`: a brace on the resting base, a second hand in the air.
+  void AddGraspSuccessors(const SymState& s, const Milestone& m, bool done, int robot, int node,
+                          std::span<const int> grasps, SuccessorList& out);
+  /// Free `robot` takes `node` from its sole holder in the air.
+  void HandoverSuccessors(const SymState& s, int robot, int node, std::span<const int> grasps,
+                          SuccessorList& out);
+  /// `robot` lets go of what it holds, when that rests or another hand holds it too.
+  void ReleaseSuccessor(const SymState& s, int robot, SuccessorList& out);
+  /// `robot`, the sole holder of an object in the air, sets it down on the table.
+  void PlaceSuccessors(const SymState& s, const Resolution& res, int robot, SuccessorList& out);
+  /// No other resting object of `s` is next to `slot` for `node`.
+  bool SlotFree(const SymState& s, int node, const TableSlot& slot) const;
+  /// The milestone's assembly, when its inputs are where it needs them.
+  void AssembleSuccessor(const SymState& s, const Milestone& m, SuccessorList& out);
   Milestone StepMilestone(int step, int next_step) const;
   /// e.g. "'seat+leg0' (moving 'leg0' onto 'seat')".
   std::string StepWords(int step) const;
@@ -192,11 +245,24 @@ class TaskSearch {
   /// Estimated bytes held by the search (nodes, queue, caches), for the memory limit.
   std::size_t MemoryBytes(std::size_t open, std::size_t closed) const;
   SymState Apply(const SymState& s, const TaskAction& a) const;
+  /// One weighted best-first search from s0 (g0 actions after the milestone's start) to a goal,
+  /// skipping edges failed at `effort`, dead ends and `forbidden` states; the goal's node path
+  /// in `path` (lazy_search.cpp).
   SearchStatus BestFirst(const SymState& s0, const Milestone& m, const Resolution& res, int effort,
                          const std::set<std::uint64_t>& excluded,
                          const std::unordered_map<std::uint64_t, bool>& dead_ends,
                          const std::unordered_set<std::uint64_t>& forbidden, long long node_budget,
                          int g0, int max_cost, std::vector<int>& path);
+  /// Validates the candidate `path` edge by edge from the prefix's last state, committing each
+  /// edge that holds to `prefix` and `actions`; a failure is tallied and suspends the edge.
+  CandidateStatus CommitCandidate(int index, const Milestone& m, const std::vector<int>& path,
+                                  const FillLimits& limits, std::vector<Committed>& prefix,
+                                  std::vector<PlanAction>& actions, int& target_failures,
+                                  bool& suspended_below);
+  /// Tallies an edge `a` from (s, c) that failed validation with `outcome` (its scene moves into
+  /// the tally when it is its gate's first).
+  void TallyEdgeFailure(const SymState& s, const ContState& c, const TaskAction& a,
+                        EdgeOutcome& outcome);
   /// Fills result.start and result.cases from the current tally (the milestone from (s0, c0)).
   void Explain(const SymState& s0, const ContState& c0, MilestoneResult& result) const;
   /// The cell at (s, c) for the failure record: robots' joints, every existing part's pose.

@@ -6,6 +6,28 @@
 
 namespace wrap {
 
+void GateTally::Add(Gate gate, const std::string& message, const CheckSubject& about) {
+  const int i = static_cast<int>(gate);
+  ++count[i];
+  if (example[i].empty()) {
+    example[i] = message;
+    subject[i] = about;
+  }
+  last_gate = gate;
+  last_message = message;
+  last_subject = about;
+}
+
+std::string GateTally::Summary(int max_gates) const {
+  const std::vector<Gate> order = Order();
+  std::string out;
+  for (int k = 0; k < static_cast<int>(order.size()) && k < max_gates; ++k) {
+    if (!out.empty()) out += "; ";
+    out += Words(order[k]);
+  }
+  return out.empty() ? "no candidate action passed the cheap checks" : out;
+}
+
 std::vector<Gate> GateTally::Order() const {
   std::vector<Gate> order;
   for (int i = 1; i < kNumGates; ++i) {

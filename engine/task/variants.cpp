@@ -42,10 +42,9 @@ bool TaskSearch::TargetAllows(const SymState& s, const Milestone& m) const {
   return target_.rb < 0 || (s.held[target_.rb] == m.base && s.grasp[target_.rb] == target_.gb);
 }
 
-void TaskSearch::FlatSuccessors(const SymState& s, const Resolution& res,
-                                std::vector<std::pair<TaskAction, SymState>>& out) {
+void TaskSearch::FlatSuccessors(const SymState& s, const Resolution& res, SuccessorList& out) {
   out.clear();
-  std::vector<std::pair<TaskAction, SymState>> some;
+  SuccessorList some;
   std::unordered_set<std::uint64_t> seen;  // releases and set-downs come from every step
   auto add = [&](const Milestone& m) {
     Successors(s, m, res, some);

@@ -7,14 +7,13 @@
 
 #include "core/frames.h"
 #include "robot/home.h"
-#include "robot/project_chain.h"
 #include "robot/kinematics.h"
+#include "robot/project_chain.h"
 
 namespace wrap {
 namespace {
 
 namespace fs = std::filesystem;
-
 
 // Reach sphere of a robot: centre at the mean TCP position of random configurations projected
 // on the first joint axis (the shoulder), radius the largest TCP distance from it.
@@ -29,8 +28,8 @@ void ComputeReach(TaskRobot& robot) {
   double reach = 0.0;
   for (int i = 0; i < 400; ++i) {
     const JointVector q = RandomConfiguration(robot.chain, rng);
-    reach = std::max(reach, (TcpPose(robot.chain, robot.X_WB, q, X_FT).translation() - shoulder)
-                                .norm());
+    reach = std::max(reach,
+                     (TcpPose(robot.chain, robot.X_WB, q, X_FT).translation() - shoulder).norm());
   }
   robot.shoulder_W = shoulder;
   robot.reach_m = reach * 1.03 + 0.01;
@@ -109,12 +108,169 @@ std::vector<Vec3> ClipToRectangle(std::vector<Vec3> poly, double x0, double x1, 
       return Vec3(a.x() + t * (b.x() - a.x()), y, a.z());
     };
   };
-  poly = clip(poly, [x0](const Vec3& p) { return p.x() >= x0; }, along_x(x0));
-  poly = clip(poly, [x1](const Vec3& p) { return p.x() <= x1; }, along_x(x1));
-  poly = clip(poly, [y0](const Vec3& p) { return p.y() >= y0; }, along_y(y0));
-  poly = clip(poly, [y1](const Vec3& p) { return p.y() <= y1; }, along_y(y1));
+  poly = clip(
+      poly, [x0](const Vec3& p) { return p.x() >= x0; }, along_x(x0));
+  poly = clip(
+      poly, [x1](const Vec3& p) { return p.x() <= x1; }, along_x(x1));
+  poly = clip(
+      poly, [y0](const Vec3& p) { return p.y() >= y0; }, along_y(y0));
+  poly = clip(
+      poly, [y1](const Vec3& p) { return p.y() <= y1; }, along_y(y1));
   for (Vec3& p : poly) p.z() = z;
   return poly;
+}
+
+// Each part in the assembly frame: pose, mass, centre of mass, box, and where it starts.
+Result<void> AddParts(const Project& project, const ProjectCheck& check, TaskWorld& w) {
+  for (int p = 0; p < w.num_parts; ++p) {
+    const Part& part = project.parts[p];
+    const PartGeometry& g = check.parts[p];
+    if (!g.loaded) {
+      return Fail(ErrorCode::kInvalidInput, "planner: part '" + part.name + "' has no mesh");
+    }
+    const Iso3 X_AP = ToIsometry(part.assembled_pose);
+    w.X_AP.push_back(X_AP);
+    w.part_mass.push_back(g.mass_kg);
+    const bool closed = g.mass_properties.volume_m3 > 0.0;
+    const Vec3 com_P = closed ? g.mass_properties.com : 0.5 * (g.aabb.min + g.aabb.max);
+    w.part_com_A.push_back(X_AP * com_P);
+    Aabb box;
+    box.min = Vec3::Constant(std::numeric_limits<double>::infinity());
+    box.max = -box.min;
+    for (const Vec3& v : g.mesh.vertices) {
+      const Vec3 a = X_AP * v;
+      box.min = box.min.cwiseMin(a);
+      box.max = box.max.cwiseMax(a);
+    }
+    w.part_box_A.push_back(box);
+    w.initial_X_WA.push_back(ToIsometry(part.initial_pose) * X_AP.inverse());
+  }
+  return {};
+}
+
+// Where the step's inputs meet: the pair of their parts whose boxes overlap most (the middle of
+// the overlap), else the nearest pair of box centres (the middle between them).
+void FindInterfacePoint(const TaskWorld& w, const AssemblyTree& tree, StepInterface& s) {
+  double best = -2.0;
+  for (int pm : tree.nodes[s.moved].parts) {
+    for (int pb : tree.nodes[s.base].parts) {
+      Vec3 c = Vec3::Zero();  // BoxOverlap leaves it unset when the boxes are apart
+      const double v = BoxOverlap(w.part_box_A[pm], w.part_box_A[pb], 1e-3, &c);
+      if (v > best) {
+        best = v;
+        s.part_moved = pm;
+        s.part_base = pb;
+        s.p_A = c;
+      }
+    }
+  }
+  if (best > 0.0) return;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int pm : tree.nodes[s.moved].parts) {
+    for (int pb : tree.nodes[s.base].parts) {
+      const Vec3 cm = 0.5 * (w.part_box_A[pm].min + w.part_box_A[pm].max);
+      const Vec3 cb = 0.5 * (w.part_box_A[pb].min + w.part_box_A[pb].max);
+      if ((cm - cb).norm() < nearest) {
+        nearest = (cm - cb).norm();
+        s.part_moved = pm;
+        s.part_base = pb;
+        s.p_A = 0.5 * (cm + cb);
+      }
+    }
+  }
+}
+
+// Each step's interface (inputs, insertion axis, connection frame and limits) and each node's
+// steps.
+Result<void> AddSteps(const Project& project, const AssemblyTree& tree, TaskWorld& w) {
+  w.steps.resize(w.num_nodes - w.num_parts);
+  for (int node = w.num_parts; node < w.num_nodes; ++node) {
+    const AssemblyNode& n = tree.nodes[node];
+    const Step& step = project.steps[n.step];
+    StepInterface& s = w.steps[node - w.num_parts];
+    s.node = node;
+    s.step = n.step;
+    s.mating = &step.mating;
+    s.moved = tree.Find(step.mating.moved);
+    s.base = tree.Find(step.mating.base);
+    if (s.moved < 0 || s.base < 0) {
+      return Fail(ErrorCode::kInvalidInput,
+                  "planner: step '" + step.name + "': mating inputs are not DAG nodes");
+    }
+    s.axis_A = step.mating.axis.normalized();
+    s.approach_m = step.mating.approach_m;
+    FindInterfacePoint(w, tree, s);
+    s.X_AC = Iso3::Identity();
+    s.X_AC.linear() = RotationWithZ(s.axis_A);
+    s.X_AC.translation() = s.p_A;
+    s.connection = BoundsFromBox(step.mating.connection_limits.value_or(project.connection_limits));
+  }
+  w.subtree_steps.resize(w.num_nodes);
+  for (int node = 0; node < w.num_nodes; ++node) CollectSteps(tree, node, w.subtree_steps[node]);
+  return {};
+}
+
+// The robots: kinematics, end effector, home, IK, wrench limits, grasp set and reach.
+Result<void> AddRobots(const Project& project, const Preprocessed& pre,
+                       const fs::path& project_file, TaskWorld& w) {
+  for (const Robot& r : project.robots) {
+    TaskRobot robot;
+    robot.name = r.name;
+    auto chain = LoadProjectChain(project, r, project_file, false);
+    if (!chain) {
+      return Fail(ErrorCode::kInvalidInput,
+                  "planner: robot '" + r.name + "': " + chain.error().message);
+    }
+    robot.chain = std::move(*chain);
+    auto ee = LoadEndEffector(r.end_effector);
+    if (!ee) {
+      return Fail(ErrorCode::kInvalidInput,
+                  "planner: robot '" + r.name + "': " + ee.error().message);
+    }
+    robot.end_effector = std::move(*ee);
+    robot.X_WB = RobotBaseInWorld(project, r);
+    robot.X_BW = robot.X_WB.inverse();
+    robot.home = FacingHomeConfiguration(robot.chain, robot.X_WB, w.table_center);
+    if (auto ur = UrAnalyticIk::FromChain(robot.chain)) robot.ur = *ur;
+    robot.limits = r.wrench_limits.value_or(project.wrench_limits);
+    for (size_t i = 0; i < pre.end_effectors.size(); ++i) {
+      if (pre.end_effectors[i] == r.end_effector) robot.grasp_set = static_cast<int>(i);
+    }
+    ComputeReach(robot);
+    w.robots.push_back(std::move(robot));
+  }
+  return {};
+}
+
+// The collision cell: robots (grippers without their fingers), parts and table.
+void BuildCellDef(const Project& project, const ProjectCheck& check, TaskWorld& w) {
+  for (size_t ri = 0; ri < w.robots.size(); ++ri) {
+    const TaskRobot& robot = w.robots[ri];
+    CellRobot cr;
+    cr.name = robot.name;
+    cr.chain = robot.chain;
+    cr.X_WB = robot.X_WB;
+    cr.end_effector.name = robot.end_effector.name;
+    cr.end_effector.X_FT = robot.end_effector.X_FT;
+    // The gripper body without its fingers: the planner adds the two finger boxes as bodies of
+    // their own, opened to each keyframe's grasp width (KeyframeSolver).
+    cr.end_effector.collision.clear();
+    for (size_t i = 0; i < robot.end_effector.collision.size(); ++i) {
+      const auto& f = robot.end_effector.finger_shapes;
+      if (static_cast<int>(i) == f[0] || static_cast<int>(i) == f[1]) continue;
+      cr.end_effector.collision.push_back(robot.end_effector.collision[i]);
+    }
+    cr.reference_link_frames.resize(robot.chain.links.size());
+    ForwardKinematics(robot.chain, robot.X_WB, robot.home, cr.reference_link_frames);
+    w.cell_def.robots.push_back(std::move(cr));
+  }
+  for (int p = 0; p < w.num_parts; ++p) {
+    w.cell_def.objects.push_back(
+        {project.parts[p].name, check.parts[p].mesh, ToIsometry(project.parts[p].initial_pose)});
+  }
+  w.cell_def.table.present = true;
+  w.cell_def.table.size = project.table.size;
+  w.cell_def.table.top_center = w.table_center;
 }
 
 }  // namespace
@@ -154,149 +310,19 @@ Result<TaskWorld> BuildTaskWorld(const Project& project, const ProjectCheck& che
   }
   w.table_top = project.table.height;
   w.table_center = Vec3(project.table.center_xy.x(), project.table.center_xy.y(), w.table_top);
-
-  // Parts.
-  for (int p = 0; p < w.num_parts; ++p) {
-    const Part& part = project.parts[p];
-    const PartGeometry& g = check.parts[p];
-    if (!g.loaded) {
-      return Fail(ErrorCode::kInvalidInput, "planner: part '" + part.name + "' has no mesh");
-    }
-    const Iso3 X_AP = ToIsometry(part.assembled_pose);
-    w.X_AP.push_back(X_AP);
-    w.part_mass.push_back(g.mass_kg);
-    const bool closed = g.mass_properties.volume_m3 > 0.0;
-    const Vec3 com_P = closed ? g.mass_properties.com : 0.5 * (g.aabb.min + g.aabb.max);
-    w.part_com_A.push_back(X_AP * com_P);
-    Aabb box;
-    box.min = Vec3::Constant(std::numeric_limits<double>::infinity());
-    box.max = -box.min;
-    for (const Vec3& v : g.mesh.vertices) {
-      const Vec3 a = X_AP * v;
-      box.min = box.min.cwiseMin(a);
-      box.max = box.max.cwiseMax(a);
-    }
-    w.part_box_A.push_back(box);
-    w.initial_X_WA.push_back(ToIsometry(part.initial_pose) * X_AP.inverse());
+  if (auto parts = AddParts(project, check, w); !parts) return std::unexpected(parts.error());
+  if (auto steps = AddSteps(project, *check.tree, w); !steps) {
+    return std::unexpected(steps.error());
   }
-
-  // Steps and their interfaces.
-  const AssemblyTree& tree = *check.tree;
-  w.steps.resize(w.num_nodes - w.num_parts);
-  for (int node = w.num_parts; node < w.num_nodes; ++node) {
-    const AssemblyNode& n = tree.nodes[node];
-    const Step& step = project.steps[n.step];
-    StepInterface& s = w.steps[node - w.num_parts];
-    s.node = node;
-    s.step = n.step;
-    s.mating = &step.mating;
-    s.moved = tree.Find(step.mating.moved);
-    s.base = tree.Find(step.mating.base);
-    if (s.moved < 0 || s.base < 0) {
-      return Fail(ErrorCode::kInvalidInput,
-                  "planner: step '" + step.name + "': mating inputs are not DAG nodes");
-    }
-    s.axis_A = step.mating.axis.normalized();
-    s.approach_m = step.mating.approach_m;
-    double best = -2.0;
-    for (int pm : tree.nodes[s.moved].parts) {
-      for (int pb : tree.nodes[s.base].parts) {
-        Vec3 c;
-        const double v = BoxOverlap(w.part_box_A[pm], w.part_box_A[pb], 1e-3, &c);
-        if (v > best) {
-          best = v;
-          s.part_moved = pm;
-          s.part_base = pb;
-          s.p_A = c;
-        }
-      }
-    }
-    if (best <= 0.0) {
-      // The inputs do not touch in their boxes: meet at the middle of the nearest pair of centres.
-      double nearest = std::numeric_limits<double>::infinity();
-      for (int pm : tree.nodes[s.moved].parts) {
-        for (int pb : tree.nodes[s.base].parts) {
-          const Vec3 cm = 0.5 * (w.part_box_A[pm].min + w.part_box_A[pm].max);
-          const Vec3 cb = 0.5 * (w.part_box_A[pb].min + w.part_box_A[pb].max);
-          if ((cm - cb).norm() < nearest) {
-            nearest = (cm - cb).norm();
-            s.part_moved = pm;
-            s.part_base = pb;
-            s.p_A = 0.5 * (cm + cb);
-          }
-        }
-      }
-    }
-    s.X_AC = Iso3::Identity();
-    s.X_AC.linear() = RotationWithZ(s.axis_A);
-    s.X_AC.translation() = s.p_A;
-    s.connection =
-        BoundsFromBox(step.mating.connection_limits.value_or(project.connection_limits));
+  if (auto robots = AddRobots(project, pre, project_file, w); !robots) {
+    return std::unexpected(robots.error());
   }
-  w.subtree_steps.resize(w.num_nodes);
-  for (int node = 0; node < w.num_nodes; ++node) CollectSteps(tree, node, w.subtree_steps[node]);
-
-  // Robots.
-  for (const Robot& r : project.robots) {
-    TaskRobot robot;
-    robot.name = r.name;
-    auto chain = LoadProjectChain(project, r, project_file, false);
-    if (!chain) {
-      return Fail(ErrorCode::kInvalidInput,
-                  "planner: robot '" + r.name + "': " + chain.error().message);
-    }
-    robot.chain = std::move(*chain);
-    auto ee = LoadEndEffector(r.end_effector);
-    if (!ee) {
-      return Fail(ErrorCode::kInvalidInput, "planner: robot '" + r.name + "': " + ee.error().message);
-    }
-    robot.end_effector = std::move(*ee);
-    robot.X_WB = RobotBaseInWorld(project, r);
-    robot.X_BW = robot.X_WB.inverse();
-    robot.home = FacingHomeConfiguration(robot.chain, robot.X_WB, w.table_center);
-    if (auto ur = UrAnalyticIk::FromChain(robot.chain)) robot.ur = *ur;
-    robot.limits = r.wrench_limits.value_or(project.wrench_limits);
-    for (size_t i = 0; i < pre.end_effectors.size(); ++i) {
-      if (pre.end_effectors[i] == r.end_effector) robot.grasp_set = static_cast<int>(i);
-    }
-    ComputeReach(robot);
-    w.robots.push_back(std::move(robot));
-  }
-
-  // The cell.
-  for (size_t ri = 0; ri < w.robots.size(); ++ri) {
-    const TaskRobot& robot = w.robots[ri];
-    CellRobot cr;
-    cr.name = robot.name;
-    cr.chain = robot.chain;
-    cr.X_WB = robot.X_WB;
-    cr.end_effector.name = robot.end_effector.name;
-    cr.end_effector.X_FT = robot.end_effector.X_FT;
-    // The gripper body without its fingers: the planner adds the two finger boxes as bodies of
-    // their own, opened to each keyframe's grasp width (KeyframeSolver).
-    cr.end_effector.collision.clear();
-    for (size_t i = 0; i < robot.end_effector.collision.size(); ++i) {
-      const auto& f = robot.end_effector.finger_shapes;
-      if (static_cast<int>(i) == f[0] || static_cast<int>(i) == f[1]) continue;
-      cr.end_effector.collision.push_back(robot.end_effector.collision[i]);
-    }
-    cr.reference_link_frames.resize(robot.chain.links.size());
-    ForwardKinematics(robot.chain, robot.X_WB, robot.home, cr.reference_link_frames);
-    w.cell_def.robots.push_back(std::move(cr));
-  }
-  for (int p = 0; p < w.num_parts; ++p) {
-    w.cell_def.objects.push_back(
-        {project.parts[p].name, check.parts[p].mesh, ToIsometry(project.parts[p].initial_pose)});
-  }
-  w.cell_def.table.present = true;
-  w.cell_def.table.size = project.table.size;
-  w.cell_def.table.top_center = w.table_center;
+  BuildCellDef(project, check, w);
   return w;
 }
 
 std::vector<std::pair<int, std::vector<Vec3>>> TableContacts(const TaskWorld& world, int node,
-                                                             const Iso3& X_WA,
-                                                             double tolerance_m) {
+                                                             const Iso3& X_WA, double tolerance_m) {
   // Each part's own hull vertices (a part's node is its subassembly), as the plan validator
   // counts them: a vertex shared by two touching parts supports both.
   const AssemblyNode& n = world.tree->nodes[node];

@@ -209,7 +209,7 @@ TEST(WrapPlanInfeasible, NoAssemblyGraspIsExplained) {
   ASSERT_NE(wheel, nullptr);
   for (GraspSet& set : wheel->grasp_sets) set.grasps.clear();
   TaskPlannerOptions options;
-  options.planner = "wrap";
+  options.planner = PlannerVariant::kWrap;
   options.wrench_mode = MatingWrenchMode::kNone;
   options.project_file = file;
   RunContext plan_ctx(0);
@@ -320,7 +320,7 @@ TEST(PlannerInfeasible, TheReportsChecksSayWhatWasTried) {
   auto pre = PreprocessProject(LoadedProject{project, check}, file);
   ASSERT_TRUE(pre.has_value()) << pre.error().message;
   TaskPlannerOptions options;
-  options.planner = "counting";
+  options.planner = PlannerVariant::kCounting;
   options.project_file = file;
   RunContext ctx(0);
   ctx.set_time_limit_s(120.0);
@@ -398,15 +398,23 @@ TEST(PlannerStats, WrenchCountersAddUp) {
 }
 
 TEST(PlannerOptions, UnknownVariantIsRefused) {
-  const fs::path file = ProjectFile("half_stool");
-  const LoadedProject lp = LoadProject(file);
-  ASSERT_TRUE(lp.ok());
-  TaskPlannerOptions options;
-  options.planner = "magic";
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 60.0, options);
-  ASSERT_FALSE(run.plan.has_value());
-  EXPECT_EQ(run.plan.error().code, ErrorCode::kInvalidInput);
-  EXPECT_NE(run.plan.error().message.find("magic"), std::string::npos);
+  const Result<PlannerVariant> variant = ParsePlannerVariant("magic");
+  ASSERT_FALSE(variant.has_value());
+  EXPECT_EQ(variant.error().code, ErrorCode::kInvalidInput);
+  EXPECT_NE(variant.error().message.find("magic"), std::string::npos);
+}
+
+// The variants' names (the CLI's, the GUI's and the plan JSON's) read back as the same variant.
+TEST(PlannerOptions, VariantNamesRoundTrip) {
+  for (PlannerVariant v :
+       {PlannerVariant::kWrap, PlannerVariant::kOptimistic, PlannerVariant::kFlat,
+        PlannerVariant::kCounting, PlannerVariant::kExact, PlannerVariant::kFine}) {
+    const Result<PlannerVariant> back = ParsePlannerVariant(ToString(v));
+    ASSERT_TRUE(back.has_value()) << ToString(v);
+    EXPECT_EQ(*back, v);
+  }
+  EXPECT_EQ(ToString(PlannerVariant::kCounting), "counting");
+  EXPECT_EQ(ToString(TaskPlannerOptions{}.planner), "wrap");
 }
 
 // A cancelled run ends with kCancelled; a run out of time reports the time limit.

@@ -32,6 +32,13 @@ std::string ParamName(const ::testing::TestParamInfo<std::string>& info) {
   return name;
 }
 
+// The variant named `name` (a test parameter's words).
+PlannerVariant Variant(const std::string& name) {
+  const Result<PlannerVariant> v = ParsePlannerVariant(name);
+  EXPECT_TRUE(v.has_value()) << name;
+  return v.value_or(PlannerVariant::kWrap);
+}
+
 // The plan as JSON without its times (which differ from run to run).
 std::string WithoutTimes(Plan plan) {
   PlanStats& s = plan.stats;
@@ -48,7 +55,7 @@ TEST_P(VariantPlan, IsSolvedValidAndDeterministic) {
   const LoadedProject lp = LoadProject(file);
   ASSERT_TRUE(lp.ok()) << project;
   TaskPlannerOptions options;
-  options.planner = variant;
+  options.planner = Variant(variant);
   const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 3, 240.0, options);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   const PlanStats& st = run.plan->stats;
@@ -102,7 +109,7 @@ TEST_P(WrapPlan, IsSolvedAndValid) {
   }
   ASSERT_TRUE(lp.ok()) << project;
   TaskPlannerOptions options;
-  options.planner = variant;
+  options.planner = Variant(variant);
   const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 240.0, options);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   ASSERT_TRUE(run.plan->stats.solved) << GetParam() << ": " << run.plan->stats.failure;
@@ -123,7 +130,7 @@ TEST(FlatLazy, StopsAtTheMemoryLimitAndSaysSo) {
     const LoadedProject lp = LoadProject(file);
     ASSERT_TRUE(lp.ok());
     TaskPlannerOptions options;
-    options.planner = "flat";
+    options.planner = PlannerVariant::kFlat;
     options.memory_limit_mb = 16;
     const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 120.0, options);
     ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
@@ -144,12 +151,12 @@ struct SearchRig : SolverRig {
   SymState s0;
   ContState c0;
 
-  bool Build(const std::string& project, const std::vector<std::string>& variants) {
+  bool Build(const std::string& project, const std::vector<PlannerVariant>& variants) {
     if (!SolverRig::Build(project).empty()) return false;
     ctx.emplace(0);
     ctx->set_time_limit_s(120.0);
     variant_options.reserve(variants.size());  // searches keep references into it
-    for (const std::string& v : variants) {
+    for (PlannerVariant v : variants) {
       variant_options.push_back(options);
       variant_options.back().planner = v;
       searches.push_back(std::make_unique<TaskSearch>(*world, tables, *solver,
@@ -175,7 +182,8 @@ struct SearchRig : SolverRig {
 // projection is at least as informed as the coarse one.
 TEST(BackwardHeuristic, NeverOverestimatesAMilestone) {
   SearchRig rig;
-  ASSERT_TRUE(rig.Build("cross", {"counting", "wrap", "fine"}));
+  ASSERT_TRUE(rig.Build("cross",
+                        {PlannerVariant::kCounting, PlannerVariant::kWrap, PlannerVariant::kFine}));
   TaskSearch& blind = *rig.searches[0];
   TaskSearch& coarse = *rig.searches[1];
   TaskSearch& fine = *rig.searches[2];
@@ -213,7 +221,7 @@ TEST_P(OptimizedPlan, IsNoWorseAndValid) {
   const LoadedProject lp = LoadProject(file);
   ASSERT_TRUE(lp.ok());
   TaskPlannerOptions options;
-  options.planner = variant;
+  options.planner = Variant(variant);
   options.optimize = true;
   const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 20.0, options);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;

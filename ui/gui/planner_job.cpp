@@ -169,9 +169,14 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
     }
     if (stopped()) return;
 
+    const Result<PlannerVariant> variant = ParsePlannerVariant(request.planner);
+    if (!variant) {
+      Finish(JobState::kFailed, variant.error().message, nullptr);
+      return;
+    }
     TaskPlannerOptions task;
     task.project_file = file;
-    task.planner = request.planner;
+    task.planner = *variant;
     task.optimize = request.optimize;
     task.force_scale = request.force_scale;
     task.wrench_mode = request.wrench == "gravity" ? MatingWrenchMode::kGravityOnly
