@@ -57,13 +57,13 @@ struct PlanIssue {
   int action = -1;
   /// Which check failed: "plan" (names, counts), "precondition" (an action not allowed in the
   /// state, or malformed), "pose" (an object where it may not be, the keyframe's object list, the
-  /// mating or approach pose, a resting object off the table), "insertion" (the moved input's straight
-  /// path from its approach pose into its mating pose cuts into the base beyond the geometry's
-  /// allowance), "joints" (a robot that may not
-  /// move did), "fk" (a TCP away from its grasp pose), "joint_limits", "collision", "clearance",
-  /// "wrench_assembly", "wrench_transport", "wrench_release", "wrench_rest" (an infeasible gate,
-  /// with the checker's reason), "incomplete" (the plan does not end with the root assembled,
-  /// resting and every robot free).
+  /// mating or approach pose, a resting object off the table), "insertion" (the moved input's
+  /// straight path from its approach pose into its mating pose cuts into the base beyond the
+  /// geometry's allowance), "joints" (a robot that may not move did), "fk" (a TCP away from its
+  /// grasp pose), "joint_limits", "collision", "clearance", "wrench_assembly",
+  /// "wrench_transport", "wrench_release", "wrench_rest" (an infeasible gate, with the checker's
+  /// reason), "incomplete" (the plan does not end with the root assembled, resting and every
+  /// robot free).
   std::string gate;
   std::string message;  ///< What was seen and what was expected, with the project's names.
 };
@@ -106,16 +106,16 @@ std::string FormatIssue(const PlanIssue& issue);
 /// the plan cannot be interpreted: a robot, part or node index out of range, a keyframe without
 /// one joint vector of the right size per robot, a project without a DAG or a mesh, a robot model
 /// or end effector that does not load; and with kInvalidInput for options out of range.
+[[nodiscard]] Result<PlanValidation> ValidatePlan(const Project& project, const ProjectCheck& check,
+                                                  const Plan& plan,
+                                                  const PlanValidationOptions& options,
+                                                  const std::filesystem::path& project_file);
+
 /// Fills every action's PlanAction::utilisation: the wrench gates of the full model at the
 /// plan's lambda (stats.force_scale), solved at each action's keyframe, whatever model the plan
 /// was made with (so a plan made without the wrench model shows where it asks too much);
 /// collisions are not checked and the plan is not judged. Fails like ValidatePlan.
 Result<void> AnnotateUtilisation(const Project& project, const ProjectCheck& check, Plan& plan,
                                  const std::filesystem::path& project_file = {});
-
-[[nodiscard]] Result<PlanValidation> ValidatePlan(const Project& project, const ProjectCheck& check,
-                                                  const Plan& plan,
-                                                  const PlanValidationOptions& options,
-                                                  const std::filesystem::path& project_file);
 
 }  // namespace wrap
