@@ -1,11 +1,11 @@
 #include "motion/motion.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <atomic>
 #include <filesystem>
 
 #include "motion/retime.h"
@@ -72,6 +72,105 @@ class CarryLoad {
   std::vector<Sample> samples_;
 };
 
+// Retime, and where an object carried by one robot would load its gripper beyond kMaxLoad with
+// its weight and inertia, that segment runs slower (the inertial part falls with the square of
+// the time stretch) and the schedule is made again (g.slow of `segments` set).
+Result<Timing> RetimeWithinLoads(const TaskWorld& world, Plan& plan,
+                                 std::vector<GeoSegment>& segments, RunContext& ctx) {
+  // An object carried by one robot loads its gripper at most this fraction of the limits, weight
+  // and inertia together (MuJoCo's welds see the same), by slowing its segments down, at most
+  // kMaxSlow times.
+  constexpr double kMaxLoad = 0.9;
+  constexpr double kMaxSlow = 6.0;
+  auto timing = Retime(world, plan, segments, &ctx);
+  const std::vector<PlanState> states = ReplayPlanStates(plan);
+  for (int round = 0; round < 4 && timing; ++round) {
+    bool slowed = false;
+    plan.trajectories = timing->trajectories;
+    for (size_t j = 0; j < segments.size(); ++j) {
+      GeoSegment& g = segments[j];
+      if (g.kind == SegmentKind::kGrip) continue;
+      const CarryLoad load(world, plan, states, timing->action_end_s, g, timing->segment_start_s[j],
+                           timing->segment_end_s[j]);
+      const double peak = load.Peak(1.0);
+      if (peak <= kMaxLoad) continue;
+      // The least slow-down that brings it within kMaxLoad, or (where the weight alone comes
+      // near) within a little of the weight's own load, in steps of 10%.
+      const double target = std::max(kMaxLoad, load.Peak(0.0) + 0.03);
+      const double f = timing->segment_stretch[j];
+      double k = 1.0;
+      while (f * k < kMaxSlow && load.Peak(1.0 / (k * k)) > target) k *= 1.1;
+      k = std::min(k, kMaxSlow / f);
+      if (ctx.Logs("motion")) {
+        ctx.Log("motion",
+                StrFormat("load: segment %zu (%s, action %d): peak %.2f (weight %.2f), %.2f x "
+                          "slower: %.2f",
+                          j, std::string(ToString(g.kind)).c_str(), g.action + 1, peak,
+                          load.Peak(0.0), f * k, load.Peak(1.0 / (k * k))));
+      }
+      if (k <= 1.0 + 1e-9) continue;
+      g.slow = f * k;
+      slowed = true;
+    }
+    if (!slowed) break;
+    timing = Retime(world, plan, segments, &ctx);
+  }
+  return timing;
+}
+
+// The plan takes the timing: trajectories, timed segments, the actions' times, the stats.
+void KeepTiming(Plan& plan, Timing& timing, size_t n_segments) {
+  plan.trajectories = std::move(timing.trajectories);
+  plan.segments = std::move(timing.segments);
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    plan.actions[i].start_s = timing.action_start_s[i];
+    plan.actions[i].end_s = timing.action_end_s[i];
+  }
+  plan.stats.motion = true;
+  plan.stats.makespan_s = timing.makespan_s;
+  plan.stats.makespan_sequential_s = timing.makespan_sequential_s;
+  plan.stats.motion_segments = static_cast<int>(n_segments);
+}
+
+// The free paths (their free segment indices) under way at the moment of a collision issue, of
+// the robot it names (any robot when it names none).
+std::vector<int> FreePathsAt(const std::vector<GeoSegment>& segments, const Timing& timing,
+                             const TrajectoryIssue& issue) {
+  std::vector<int> redo;
+  for (size_t j = 0; j < segments.size(); ++j) {
+    const GeoSegment& g = segments[j];
+    if (g.free_index < 0 || issue.t < timing.segment_start_s[j] - 1e-9 ||
+        issue.t > timing.segment_end_s[j] + 1e-9) {
+      continue;
+    }
+    if (issue.robot >= 0 &&
+        std::find(g.robots.begin(), g.robots.end(), issue.robot) == g.robots.end()) {
+      continue;
+    }
+    redo.push_back(g.free_index);
+  }
+  return redo;
+}
+
+// The failure of a timed result the trajectory check refused: the action under way at the first
+// issue's moment, not to be retried. (failure.scene is left as it is.)
+void SetTimedFailure(const Plan& plan, const TrajectoryCheck& check, MotionFailure& failure) {
+  const TrajectoryIssue& issue = check.issues.front();
+  int action = static_cast<int>(plan.actions.size()) - 1;
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    if (plan.actions[i].end_s >= issue.t) {
+      action = static_cast<int>(i);
+      break;
+    }
+  }
+  failure.action = std::max(action, 0);
+  failure.blame = failure.action;
+  failure.segment = "timed";
+  failure.suspend = false;
+  failure.message = "the trajectory check found " + std::to_string(check.issues.size()) +
+                    " issue(s), the first: " + FormatTrajectoryIssue(plan, issue);
+}
+
 }  // namespace
 
 Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const MotionOptions& options,
@@ -80,11 +179,6 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
   // Times a free path is searched again with another seed when the timed result grazes
   // something inside it (a contact narrower than the path search's step: see below).
   constexpr int kMaxRepairs = 3;
-  // An object carried by one robot loads its gripper at most this fraction of the limits, weight
-  // and inertia together (MuJoCo's welds see the same), by slowing its segments down, at most
-  // kMaxSlow times.
-  constexpr double kMaxLoad = 0.9;
-  constexpr double kMaxSlow = 6.0;
   MotionAttempt out;
   const std::vector<PlanAction> original = plan.actions;
   for (int repair = 0;; ++repair) {
@@ -103,56 +197,12 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
     plan.actions = std::move(work.actions);
     ctx.Progress("retime", -1.0,
                  std::to_string(segments->size()) + " segments timed into per-robot trajectories");
-    auto timing = Retime(world, plan, *segments, &ctx);
-    // Where an object carried by one robot would load its gripper beyond kMaxLoad with its
-    // weight and inertia, that segment runs slower (the inertial part falls with the square of
-    // the time stretch), and the schedule is made again.
-    const std::vector<PlanState> states = ReplayPlanStates(plan);
-    for (int round = 0; round < 4 && timing; ++round) {
-      bool slowed = false;
-      plan.trajectories = timing->trajectories;
-      for (size_t j = 0; j < segments->size(); ++j) {
-        GeoSegment& g = (*segments)[j];
-        if (g.kind == SegmentKind::kGrip) continue;
-        const CarryLoad load(world, plan, states, timing->action_end_s, g,
-                             timing->segment_start_s[j], timing->segment_end_s[j]);
-        const double peak = load.Peak(1.0);
-        if (peak <= kMaxLoad) continue;
-        // The least slow-down that brings it within kMaxLoad, or (where the weight alone comes
-        // near) within a little of the weight's own load, in steps of 10%.
-        const double target = std::max(kMaxLoad, load.Peak(0.0) + 0.03);
-        const double f = timing->segment_stretch[j];
-        double k = 1.0;
-        while (f * k < kMaxSlow && load.Peak(1.0 / (k * k)) > target) k *= 1.1;
-        k = std::min(k, kMaxSlow / f);
-        if (ctx.Logs("motion")) {
-          ctx.Log("motion",
-                  StrFormat("load: segment %zu (%s, action %d): peak %.2f (weight %.2f), %.2f x "
-                            "slower: %.2f",
-                            j, std::string(ToString(g.kind)).c_str(), g.action + 1, peak,
-                            load.Peak(0.0), f * k, load.Peak(1.0 / (k * k))));
-        }
-        if (k <= 1.0 + 1e-9) continue;
-        g.slow = f * k;
-        slowed = true;
-      }
-      if (!slowed) break;
-      timing = Retime(world, plan, *segments, &ctx);
-    }
+    auto timing = RetimeWithinLoads(world, plan, *segments, ctx);
     const double t_retime = Since(t0);
     out.t_retime_s += t_retime;
     ctx.AddTime("retime", t_retime);
     if (!timing) return std::unexpected(timing.error());
-    plan.trajectories = std::move(timing->trajectories);
-    plan.segments = std::move(timing->segments);
-    for (size_t i = 0; i < plan.actions.size(); ++i) {
-      plan.actions[i].start_s = timing->action_start_s[i];
-      plan.actions[i].end_s = timing->action_end_s[i];
-    }
-    plan.stats.motion = true;
-    plan.stats.makespan_s = timing->makespan_s;
-    plan.stats.makespan_sequential_s = timing->makespan_sequential_s;
-    plan.stats.motion_segments = static_cast<int>(segments->size());
+    KeepTiming(plan, *timing, segments->size());
     if (!options.self_check) break;
     t0 = std::chrono::steady_clock::now();
     ctx.Progress("check", -1.0, "the timed trajectories, densely");
@@ -169,18 +219,7 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
     // moment again with other seeds; the rest of the motion comes from the cache.
     std::vector<int> redo;
     if (issue.check == "collision" && repair < kMaxRepairs) {
-      for (size_t j = 0; j < segments->size(); ++j) {
-        const GeoSegment& g = (*segments)[j];
-        if (g.free_index < 0 || issue.t < timing->segment_start_s[j] - 1e-9 ||
-            issue.t > timing->segment_end_s[j] + 1e-9) {
-          continue;
-        }
-        if (issue.robot >= 0 &&
-            std::find(g.robots.begin(), g.robots.end(), issue.robot) == g.robots.end()) {
-          continue;
-        }
-        redo.push_back(g.free_index);
-      }
+      redo = FreePathsAt(*segments, *timing, issue);
     }
     if (ctx.Logs("motion")) {
       ctx.Log("motion", "timed: " + FormatTrajectoryIssue(plan, issue) +
@@ -189,8 +228,8 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
     if (!options.dump_refused_dir.empty()) {
       // Debugging: keep every refused timed result (a folder; one file per refusal).
       static std::atomic<int> dumped = 0;
-      (void)SavePlan(plan, options.dump_refused_dir /
-                               ("refused_" + std::to_string(dumped++) + ".json"));
+      (void)SavePlan(plan,
+                     options.dump_refused_dir / ("refused_" + std::to_string(dumped++) + ".json"));
     }
     plan.trajectories.clear();
     plan.segments.clear();
@@ -204,20 +243,7 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
       }
       continue;
     }
-    // The action under way at the first issue's moment.
-    int action = static_cast<int>(plan.actions.size()) - 1;
-    for (size_t i = 0; i < plan.actions.size(); ++i) {
-      if (plan.actions[i].end_s >= issue.t) {
-        action = static_cast<int>(i);
-        break;
-      }
-    }
-    out.failure.action = std::max(action, 0);
-    out.failure.blame = out.failure.action;
-    out.failure.segment = "timed";
-    out.failure.suspend = false;
-    out.failure.message = "the trajectory check found " + std::to_string(check->issues.size()) +
-                          " issue(s), the first: " + FormatTrajectoryIssue(plan, issue);
+    SetTimedFailure(plan, *check, out.failure);
     return out;
   }
   out.solved = true;

@@ -1,13 +1,14 @@
 // Motion of one task plan (paper §IV-E, §IV-F): the geometric motion (free paths and skills) at
 // an effort level, then retiming into per-robot trajectories that run concurrently where the
-// robots do not depend on each other. The front door of the motion stage.
+// robots do not depend on each other. The front door of the motion stage (its options, failure
+// record and path cache are in motion_options.h, included here).
 #pragma once
 
 #include <cstdint>
 
 #include "core/result.h"
 #include "core/run_context.h"
-#include "motion/segments.h"
+#include "motion/motion_options.h"
 #include "task/plan.h"
 #include "task/world.h"
 

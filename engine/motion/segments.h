@@ -5,8 +5,6 @@
 #pragma once
 
 #include <cstdint>
-#include <filesystem>
-#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -15,6 +13,7 @@
 
 #include "core/result.h"
 #include "core/run_context.h"
+#include "motion/motion_options.h"
 #include "motion/scene.h"
 #include "task/plan.h"
 #include "task/world.h"
@@ -26,43 +25,6 @@ enum class SegmentKind { kFree, kApproach, kRetreat, kLift, kDescend, kInsert, k
 
 /// "free", "approach", "retreat", "lift", "descend", "insert", "carry", "grip".
 std::string_view ToString(SegmentKind kind);
-
-/// Options of the geometric motion.
-struct MotionOptions {
-  /// Joint-space resolution of the path search's collision checks along a motion: consecutive
-  /// checked states differ by at most this in every joint [rad]; skills and final paths are
-  /// checked 4 times finer. (The trajectory check samples at 0.02 rad.)
-  double resolution_rad = 0.01;
-  /// Work budget of a free segment's path search at effort 0: collision checks (RRT-Connect's
-  /// states and motions). Budgets count work, not time, so that the same project, options and
-  /// seed give the same plan whatever the machine's load, its cores or a sanitizer's slowdown.
-  long long segment_checks = 200000;
-  /// Work budget of the search over a carried object's poses at effort 1 (it runs from effort
-  /// 1 on): edges tried, each tracked by the holders' IK and checked for collisions.
-  int carry_edges = 500;
-  int max_effort = 3;  ///< Effort levels 0..max_effort; the budgets double per level.
-  double approach_m = 0.04;         ///< Straight approach to (and retreat from) a grasp [m].
-  double lift_m = 0.02;             ///< Straight lift off (and descent onto) the table [m].
-  double cartesian_step_m = 0.004;  ///< Spacing of IK samples along a straight move [m].
-  double skill_speed_mps = 0.05;    ///< TCP speed of approach, retreat, lift, descent [m/s].
-  double insert_speed_mps = 0.02;   ///< TCP speed of an insertion [m/s].
-  double carry_speed_mps = 0.10;    ///< Object speed of a two-handed carry [m/s].
-  double grip_s = 0.4;              ///< A gripper closing or opening at a keyframe [s].
-  /// Shortcut attempts per free path.
-  int shortcut_attempts = 16;
-  /// Along a free path, an object held by one robot may load its gripper (its weight, in the
-  /// grasp frame, against the transport box of a vacuum cup or the two-finger box) up to this
-  /// fraction of the limits, or up to the path's ends' load where that is higher: the task plan's
-  /// wrench gates hold at the keyframes only, and an object turned on the way (a seat held by
-  /// its edge) can hang on its gripper beyond the limits; the rest is kept for the accelerations.
-  double transport_load_max = 0.8;
-  /// Run the independent trajectory check on the timed result; a plan that fails it has no
-  /// motion (its first issue is the failure), so no colliding trajectory leaves the planner.
-  bool self_check = true;
-  /// Debugging: every timed result the self-check refuses is saved here as a plan JSON
-  /// (refused_N.json); empty: none (`wrap plan --dump-refused DIR`).
-  std::filesystem::path dump_refused_dir;
-};
 
 /// A segment of the geometric motion.
 struct GeoSegment {
@@ -86,35 +48,6 @@ struct GeoSegment {
   /// the sampling bound, per body: [0] the whole sweep, then the sweeps of consecutive runs of
   /// samples. Two segments whose boxes do not meet can run at the same time.
   std::vector<std::vector<Aabb>> sweep;
-};
-
-/// Why the geometric motion of a plan could not be made.
-struct MotionFailure {
-  int action = -1;  ///< Action of the segment.
-  /// The action whose keyframe made it fail (the task plan's edge to avoid): the segment's own,
-  /// or, for a retreat, the action that let go.
-  int blame = -1;
-  std::string segment;   ///< Its kind.
-  bool suspend = false;  ///< True when more effort may find it (a path search ran out of time).
-  std::string message;   ///< The segment and the reason, in words.
-  /// The cell at the collision the message names (robots where they hit, the two bodies), or
-  /// where the segment starts.
-  FailureScene scene;
-};
-
-/// Solved free paths of one plan, kept across effort levels (by free segment index).
-struct MotionCache {
-  struct Path {
-    std::vector<int> robots;                          ///< Robots of the composite space.
-    std::vector<std::vector<JointVector>> waypoints;  ///< Empty where not solved.
-    /// The scene the path was solved in (every robot's joints, the objects, the holds and the
-    /// finger openings): a path is reused only in the very same scene.
-    std::vector<double> scene;
-  };
-  std::vector<Path> free_paths;  ///< By free segment index.
-  /// Free paths to search again with another seed (free segment index -> how many times): the
-  /// timed result grazed something between the path's checked states (see PlanMotion).
-  std::map<int, int> reseed;
 };
 
 /// An object that one robot carries alone: its mass, its centre of mass in the grasp (TCP)

@@ -98,6 +98,38 @@ void Apply(Replay& s, const PlanAction& a) {
   }
 }
 
+// A contact that a skill of the plan declares, from t0 to t1: a gripper (robot) and object a (an
+// approach or retreat), or, robot -1, an insertion's inputs a (moving into) b.
+struct Window {
+  double t0, t1;
+  int robot;  // -1: object pair (an insertion: a moves into b)
+  int a, b;
+  int step = -1;  // an insertion's step node
+};
+
+// Whether a window allows the contact at time t: robot >= 0, its gripper and object a; robot
+// -1, the objects a and b.
+bool InWindow(const std::vector<Window>& windows, double t, int robot, int a, int b) {
+  for (const Window& wdw : windows) {
+    if (t < wdw.t0 - 1e-9 || t > wdw.t1 + 1e-9 || wdw.robot != robot) continue;
+    if (robot >= 0 && wdw.a == a) return true;
+    if (robot < 0 && ((wdw.a == a && wdw.b == b) || (wdw.a == b && wdw.b == a))) return true;
+  }
+  return false;
+}
+
+// The dense check's replay as it walks its sample times.
+struct DenseState {
+  Replay s;                 // who holds what, the objects' poses
+  std::vector<int> events;  // actions in the order of their moments
+  size_t next_event = 0;    // the first not yet applied
+  std::vector<Window> windows;
+  std::set<std::pair<int, int>> reported;  // pairs already reported (bodies, robot and object)
+  std::vector<std::vector<Iso3>> frames;   // per robot: its links' frames
+  std::vector<JointVector> q;              // per robot: its joints
+  std::vector<Iso3> X_WT;                  // per robot: its TCP
+};
+
 class Checker {
  public:
   Checker(const TaskWorld& w, const Plan& p, const TrajectoryCheckOptions& o)
@@ -112,13 +144,38 @@ class Checker {
   std::string Node(int n) const { return "'" + plan_.nodes[n] + "'"; }
   void CheckKnots(int r);
   void CheckEvents();
+  // The dense check (CheckTrajectories): every sample time, the cell replayed there, nothing
+  // colliding beyond the contacts the plan allows.
   void CheckDense();
+  // The parts' convex hulls (hull_): their lowest points against the table top.
+  void ComputeHulls();
+  // Every knot, and between knots so that no joint moves more than the resolution; the actions'
+  // moments.
+  std::vector<double> SampleTimes() const;
+  // The actions in the order of their moments.
+  std::vector<int> EventOrder() const;
+  // The contact windows the plan's skills declare.
+  std::vector<Window> ContactWindows() const;
+  // One sample at time t: events up to t applied, robots and objects posed, contacts allowed,
+  // the cell checked. False when the cell cannot be built (the check stops).
+  bool CheckSample(double t, DenseState& d);
+  // Every robot at its trajectory's joints at t, in the cell of its finger openings then (null
+  // when that cell cannot be built).
+  Cell* PoseRobots(double t, DenseState& d);
+  // The objects where they are at t (carried: from their first holder's TCP), each holder
+  // checked against its grasp; node_of (per part) and node_X (per object) filled.
+  void PlaceObjects(double t, DenseState& d, Cell& cell, std::vector<int>& node_of,
+                    std::map<int, Iso3>& node_X);
+  // The contacts allowed at t: the parts of one object, the insertion windows' pairs, an
+  // object touching the table from above, a gripper and what it holds or its window's object.
+  void AllowContacts(double t, const DenseState& d, Cell& cell, const std::vector<int>& node_of);
+  // The cell's collision query; the first collision of each pair of bodies is an issue.
+  void CheckCollision(double t, DenseState& d, Cell& cell);
   Cell* CellFor(const std::vector<double>& openings);
   // The moved input M of an insertion against its base B, both at their poses at this sample,
   // with the meshes: more overlap than the geometry allows where M is along its path is a
   // collision (the cell lets the two touch).
-  void CheckInsertionOverlap(double t, int step_node, int M, int B,
-                             const std::map<int, Iso3>& X_WA,
+  void CheckInsertionOverlap(double t, int step_node, int M, int B, const std::map<int, Iso3>& X_WA,
                              std::set<std::pair<int, int>>& reported);
 
   const TaskWorld& w_;
@@ -126,7 +183,7 @@ class Checker {
   const TrajectoryCheckOptions& opt_;
   TrajectoryCheck out_;
   std::map<std::vector<long long>, Cell> cells_;
-  std::vector<std::vector<Vec3>> hull_;  // per part, in the part frame
+  std::vector<std::vector<Vec3>> hull_;       // per part, in the part frame
   std::optional<AssemblyGeometry> geometry_;  // the parts' meshes, for insertion overlaps
 };
 
@@ -148,8 +205,8 @@ void Checker::CheckInsertionOverlap(double t, int step_node, int M, int B,
   for (int node : {M, B}) {
     for (int p : w_.tree->nodes[node].parts) X[p] = X_WA.at(node) * w_.X_AP[p];
   }
-  const auto o = OverlapBeyond(*geometry_, w_.tree->nodes[M].parts, w_.tree->nodes[B].parts, X,
-                               allowed);
+  const auto o =
+      OverlapBeyond(*geometry_, w_.tree->nodes[M].parts, w_.tree->nodes[B].parts, X, allowed);
   if (!o || !reported.insert({-100 - o->part_a, -100 - o->part_b}).second) return;
   Issue(t, -1, "collision",
         "'" + geometry_->name(o->part_a) + "' cuts into '" + geometry_->name(o->part_b) +
@@ -302,11 +359,30 @@ Cell* Checker::CellFor(const std::vector<double>& openings) {
 
 void Checker::CheckDense() {
   const int n_robots = static_cast<int>(w_.robots.size());
-  const int n_parts = w_.num_parts;
-  for (int p = 0; p < n_parts; ++p) {
+  ComputeHulls();
+  const std::vector<double> times = SampleTimes();
+  DenseState d;
+  d.events = EventOrder();
+  d.windows = ContactWindows();
+  d.s.held.assign(n_robots, -1);
+  d.s.grasp.resize(n_robots);
+  for (const PlanObject& o : plan_.initial.objects) d.s.things[o.node] = {o.resting, o.X_WA, {}};
+  d.frames.resize(n_robots);
+  d.q.resize(n_robots);
+  d.X_WT.resize(n_robots);
+  for (double t : times) {
+    if (!CheckSample(t, d)) return;
+  }
+}
+
+void Checker::ComputeHulls() {
+  for (int p = 0; p < w_.num_parts; ++p) {
     auto hull = ComputeConvexHull(w_.cell_def.objects[p].mesh);
     hull_.push_back(hull ? hull->mesh.vertices : w_.cell_def.objects[p].mesh.vertices);
   }
+}
+
+std::vector<double> Checker::SampleTimes() const {
   // Sample times: every knot, and in between so that no joint moves more than the resolution.
   std::vector<double> times;
   for (const RobotTrajectory& tr : plan_.trajectories) {
@@ -325,18 +401,18 @@ void Checker::CheckDense() {
   times.erase(std::unique(times.begin(), times.end(),
                           [](double x, double y) { return std::abs(x - y) < 1e-9; }),
               times.end());
-  // Events in time order.
+  return times;
+}
+
+std::vector<int> Checker::EventOrder() const {
   std::vector<int> events(plan_.actions.size());
   for (size_t i = 0; i < events.size(); ++i) events[i] = static_cast<int>(i);
   std::stable_sort(events.begin(), events.end(),
                    [&](int x, int y) { return plan_.actions[x].end_s < plan_.actions[y].end_s; });
-  // Contact windows declared by the plan's skills.
-  struct Window {
-    double t0, t1;
-    int robot;  // -1: object pair (an insertion: a moves into b)
-    int a, b;
-    int step = -1;  // an insertion's step node
-  };
+  return events;
+}
+
+std::vector<Window> Checker::ContactWindows() const {
   std::vector<Window> windows;
   for (const MotionSegment& m : plan_.segments) {
     if (m.kind == "insert" && m.objects.size() >= 2 && m.action >= 0) {
@@ -352,120 +428,130 @@ void Checker::CheckDense() {
       for (int o : m.objects) windows.push_back({m.start_s, m.end_s, m.robots[0], o, -1});
     }
   }
-  Replay s;
-  s.held.assign(n_robots, -1);
-  s.grasp.resize(n_robots);
-  for (const PlanObject& o : plan_.initial.objects) s.things[o.node] = {o.resting, o.X_WA, {}};
-  size_t next_event = 0;
-  std::set<std::pair<int, int>> reported;
-  std::vector<std::vector<Iso3>> frames(n_robots);
-  std::vector<JointVector> q(n_robots);
-  std::vector<Iso3> X_WT(n_robots);
-  for (double t : times) {
-    while (next_event < events.size() && plan_.actions[events[next_event]].end_s <= t + 1e-12) {
-      Apply(s, plan_.actions[events[next_event]]);
-      ++next_event;
+  return windows;
+}
+
+bool Checker::CheckSample(double t, DenseState& d) {
+  while (d.next_event < d.events.size() &&
+         plan_.actions[d.events[d.next_event]].end_s <= t + 1e-12) {
+    Apply(d.s, plan_.actions[d.events[d.next_event]]);
+    ++d.next_event;
+  }
+  Cell* cell = PoseRobots(t, d);
+  if (cell == nullptr) return false;
+  std::vector<int> node_of(w_.num_parts, -1);
+  std::map<int, Iso3> node_X;
+  PlaceObjects(t, d, *cell, node_of, node_X);
+  for (const Window& wdw : d.windows) {
+    if (wdw.robot < 0 && t >= wdw.t0 - 1e-9 && t <= wdw.t1 + 1e-9) {
+      CheckInsertionOverlap(t, wdw.step, wdw.a, wdw.b, node_X, d.reported);
     }
-    std::vector<double> openings(n_robots);
-    for (int r = 0; r < n_robots; ++r) {
-      q[r] = SampleTrajectory(plan_.trajectories[r], t);
-      openings[r] = OpeningAt(plan_.trajectories[r], t);
-      const TaskRobot& R = w_.robots[r];
-      X_WT[r] = TcpPose(R.chain, R.X_WB, q[r], R.end_effector.X_FT);
+  }
+  AllowContacts(t, d, *cell, node_of);
+  CheckCollision(t, d, *cell);
+  return true;
+}
+
+Cell* Checker::PoseRobots(double t, DenseState& d) {
+  const int n_robots = static_cast<int>(w_.robots.size());
+  std::vector<double> openings(n_robots);
+  for (int r = 0; r < n_robots; ++r) {
+    d.q[r] = SampleTrajectory(plan_.trajectories[r], t);
+    openings[r] = OpeningAt(plan_.trajectories[r], t);
+    const TaskRobot& R = w_.robots[r];
+    d.X_WT[r] = TcpPose(R.chain, R.X_WB, d.q[r], R.end_effector.X_FT);
+  }
+  Cell* cell = CellFor(openings);
+  if (cell == nullptr) return nullptr;
+  ++out_.samples;
+  for (int r = 0; r < n_robots; ++r) {
+    d.frames[r].resize(w_.robots[r].chain.links.size());
+    ForwardKinematics(w_.robots[r].chain, w_.robots[r].X_WB, d.q[r], d.frames[r]);
+    cell->SetConfiguration(r, std::span<const double>(d.q[r].data(), d.q[r].size()), d.frames[r]);
+  }
+  return cell;
+}
+
+void Checker::PlaceObjects(double t, DenseState& d, Cell& cell, std::vector<int>& node_of,
+                           std::map<int, Iso3>& node_X) {
+  for (auto& [node, thing] : d.s.things) {
+    Iso3 X_WA = thing.X_WA;
+    if (!thing.resting && !thing.holders.empty()) {
+      const int c = thing.holders.front();
+      const PlanGrasp& g = d.s.grasp[c];
+      X_WA = d.X_WT[c] * (w_.X_AP[g.part] * g.X_PG).inverse();
     }
-    Cell* cell = CellFor(openings);
-    if (cell == nullptr) return;
-    ++out_.samples;
-    for (int r = 0; r < n_robots; ++r) {
-      frames[r].resize(w_.robots[r].chain.links.size());
-      ForwardKinematics(w_.robots[r].chain, w_.robots[r].X_WB, q[r], frames[r]);
-      cell->SetConfiguration(r, std::span<const double>(q[r].data(), q[r].size()), frames[r]);
-    }
-    CollisionWorld& cw = cell->world();
-    std::vector<int> node_of(n_parts, -1);
-    std::map<int, Iso3> node_X;
-    for (auto& [node, thing] : s.things) {
-      Iso3 X_WA = thing.X_WA;
-      if (!thing.resting && !thing.holders.empty()) {
-        const int c = thing.holders.front();
-        const PlanGrasp& g = s.grasp[c];
-        X_WA = X_WT[c] * (w_.X_AP[g.part] * g.X_PG).inverse();
-      }
-      for (int r : thing.holders) {
-        const PlanGrasp& g = s.grasp[r];
-        const Iso3 want = X_WA * w_.X_AP[g.part] * g.X_PG;
-        const double dp = (want.translation() - X_WT[r].translation()).norm();
-        const double dr = Eigen::AngleAxisd(want.linear().transpose() * X_WT[r].linear()).angle();
-        if (dp > opt_.grasp_tolerance_m || dr > opt_.grasp_tolerance_rad) {
-          if (reported.insert({-10 - r, node}).second) {
-            Issue(t, r, "grasp",
-                  "its TCP is " + Num(dp * 1000, "%.1f") + " mm / " + Num(dr, "%.3f") +
-                      " rad away from its grasp on " + Node(node) + ", which " +
-                      (thing.resting ? "rests" : "another robot carries"));
-          }
+    for (int r : thing.holders) {
+      const PlanGrasp& g = d.s.grasp[r];
+      const Iso3 want = X_WA * w_.X_AP[g.part] * g.X_PG;
+      const double dp = (want.translation() - d.X_WT[r].translation()).norm();
+      const double dr = Eigen::AngleAxisd(want.linear().transpose() * d.X_WT[r].linear()).angle();
+      if (dp > opt_.grasp_tolerance_m || dr > opt_.grasp_tolerance_rad) {
+        if (d.reported.insert({-10 - r, node}).second) {
+          Issue(t, r, "grasp",
+                "its TCP is " + Num(dp * 1000, "%.1f") + " mm / " + Num(dr, "%.3f") +
+                    " rad away from its grasp on " + Node(node) + ", which " +
+                    (thing.resting ? "rests" : "another robot carries"));
         }
       }
-      node_X[node] = X_WA;
-      for (int p : w_.tree->nodes[node].parts) {
-        node_of[p] = node;
-        cell->SetObjectPose(p, X_WA * w_.X_AP[p]);
-      }
     }
-    for (const Window& wdw : windows) {
-      if (wdw.robot < 0 && t >= wdw.t0 - 1e-9 && t <= wdw.t1 + 1e-9) {
-        CheckInsertionOverlap(t, wdw.step, wdw.a, wdw.b, node_X, reported);
-      }
+    node_X[node] = X_WA;
+    for (int p : w_.tree->nodes[node].parts) {
+      node_of[p] = node;
+      cell.SetObjectPose(p, X_WA * w_.X_AP[p]);
     }
-    auto window = [&](int robot, int a, int b) {
-      for (const Window& wdw : windows) {
-        if (t < wdw.t0 - 1e-9 || t > wdw.t1 + 1e-9 || wdw.robot != robot) continue;
-        if (robot >= 0 && wdw.a == a) return true;
-        if (robot < 0 && ((wdw.a == a && wdw.b == b) || (wdw.a == b && wdw.b == a))) return true;
-      }
-      return false;
-    };
-    for (int p = 0; p < n_parts; ++p) {
-      const int node = node_of[p];
-      cell->SetObjectEnabled(p, node >= 0);
-      for (int o = p + 1; o < n_parts; ++o) {
-        const bool ok =
-            node >= 0 && node_of[o] >= 0 && (node == node_of[o] || window(-1, node, node_of[o]));
-        cell->SetObjectPairAllowed(p, o, ok);
-      }
-      bool table = false;
-      if (node >= 0) {
-        const Iso3& X = cw.pose(cell->object_body(p));
-        double lowest = std::numeric_limits<double>::infinity();
-        for (const Vec3& v : hull_[p]) lowest = std::min(lowest, (X * v).z());
-        table = lowest >= w_.table_top - opt_.table_tolerance_m;
-      }
-      cw.SetAllowed(cell->object_body(p), cell->table_body(), table);
-      for (int r = 0; r < n_robots; ++r) {
-        const bool holds = node >= 0 && s.held[r] == node;
-        cw.SetAllowed(cell->object_body(p), cell->end_effector_body(r),
-                      holds || (node >= 0 && window(r, node, -1)));
-      }
+  }
+}
+
+void Checker::AllowContacts(double t, const DenseState& d, Cell& cell,
+                            const std::vector<int>& node_of) {
+  const int n_robots = static_cast<int>(w_.robots.size());
+  const int n_parts = w_.num_parts;
+  CollisionWorld& cw = cell.world();
+  for (int p = 0; p < n_parts; ++p) {
+    const int node = node_of[p];
+    cell.SetObjectEnabled(p, node >= 0);
+    for (int o = p + 1; o < n_parts; ++o) {
+      const bool ok = node >= 0 && node_of[o] >= 0 &&
+                      (node == node_of[o] || InWindow(d.windows, t, -1, node, node_of[o]));
+      cell.SetObjectPairAllowed(p, o, ok);
     }
-    ++out_.collision_checks;
-    CollisionResult hit;
-    CollisionRequest request;
-    if (cell->InCollision(&hit, request)) {
-      const auto key = std::minmax(hit.first.body_a.value, hit.first.body_b.value);
-      if (opt_.log != nullptr && opt_.log->Logs("motion")) {
-        for (const auto& [node, thing] : s.things) {
-          opt_.log->Log("motion",
-                        StrFormat("check: t=%.2f %s resting %d holders %zu X_WA %.3f %.3f %.3f",
-                                  t, plan_.nodes[node].c_str(), thing.resting,
-                                  thing.holders.size(), thing.X_WA.translation().x(),
-                                  thing.X_WA.translation().y(), thing.X_WA.translation().z()));
-        }
-      }
-      if (reported.insert(key).second) {
-        Issue(t, cell->robot_of(hit.first.body_a), "collision",
-              "'" + cw.body_name(hit.first.body_a) + "' collides with '" +
-                  cw.body_name(hit.first.body_b) + "' (" + cell->Describe(hit.first) + ")");
-      }
+    bool table = false;
+    if (node >= 0) {
+      const Iso3& X = cw.pose(cell.object_body(p));
+      double lowest = std::numeric_limits<double>::infinity();
+      for (const Vec3& v : hull_[p]) lowest = std::min(lowest, (X * v).z());
+      table = lowest >= w_.table_top - opt_.table_tolerance_m;
     }
+    cw.SetAllowed(cell.object_body(p), cell.table_body(), table);
+    for (int r = 0; r < n_robots; ++r) {
+      const bool holds = node >= 0 && d.s.held[r] == node;
+      cw.SetAllowed(cell.object_body(p), cell.end_effector_body(r),
+                    holds || (node >= 0 && InWindow(d.windows, t, r, node, -1)));
+    }
+  }
+}
+
+void Checker::CheckCollision(double t, DenseState& d, Cell& cell) {
+  CollisionWorld& cw = cell.world();
+  ++out_.collision_checks;
+  CollisionResult hit;
+  CollisionRequest request;
+  if (!cell.InCollision(&hit, request)) return;
+  const auto key = std::minmax(hit.first.body_a.value, hit.first.body_b.value);
+  if (opt_.log != nullptr && opt_.log->Logs("motion")) {
+    for (const auto& [node, thing] : d.s.things) {
+      opt_.log->Log("motion",
+                    StrFormat("check: t=%.2f %s resting %d holders %zu X_WA %.3f %.3f %.3f", t,
+                              plan_.nodes[node].c_str(), thing.resting, thing.holders.size(),
+                              thing.X_WA.translation().x(), thing.X_WA.translation().y(),
+                              thing.X_WA.translation().z()));
+    }
+  }
+  if (d.reported.insert(key).second) {
+    Issue(t, cell.robot_of(hit.first.body_a), "collision",
+          "'" + cw.body_name(hit.first.body_a) + "' collides with '" +
+              cw.body_name(hit.first.body_b) + "' (" + cell.Describe(hit.first) + ")");
   }
 }
 

@@ -13,7 +13,7 @@
 #include "model/project.h"
 #include "model/validate.h"
 #include "motion/keyframe_opt.h"
-#include "motion/segments.h"
+#include "motion/motion.h"
 #include "task/plan.h"
 #include "task/planner.h"
 

@@ -1,0 +1,434 @@
+// The skills: straight moves at contacts. A gripper's approach to its grasp and retreat from what
+// it let go (along the gripper axis), the lift of an object off the table and its descent onto
+// it, and an insertion along its mating axis, with the slide start and the hover above the table
+// that an insertion may need.
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "motion/segments_internal.h"
+#include "robot/ik.h"
+#include "robot/kinematics.h"
+
+namespace wrap::detail {
+
+std::vector<JointVector> SegmentBuilder::BackOff(int robot, const JointVector& q, double* length) {
+  const Iso3 X0 = Tcp(robot, q);
+  const Vec3 axis = X0.linear().col(2);
+  // The straight move back by d, collision-free, or empty (last_hit_ says why).
+  auto straight = [&](double d) {
+    const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
+    auto target = [X0, axis, d](double s) {
+      Iso3 X = X0;
+      X.translation() -= s * d * axis;
+      return X;
+    };
+    auto path = Track({robot}, {q}, {target}, steps);
+    std::vector<JointVector> out;
+    if (path.empty()) {
+      last_hit_ = "no IK solution along the line";
+    } else if (PathClear({robot}, path)) {
+      for (auto& wp : path) out.push_back(wp[0]);
+    }
+    return out;
+  };
+  // Longer first where the end of the usual length is in a tight pocket (free path searches
+  // hardly leave one); then the usual length and shorter ones.
+  std::vector<std::vector<JointVector>> longer;
+  for (double d : {opt_.approach_m, 2 * opt_.approach_m, 3 * opt_.approach_m}) {
+    std::vector<JointVector> out = straight(d);
+    if (out.empty()) break;
+    *length = d;
+    if (!Tight(robot, out.back()) || d > 2.5 * opt_.approach_m) return out;
+    longer.push_back(std::move(out));
+  }
+  if (!longer.empty()) {
+    *length = opt_.approach_m * static_cast<double>(longer.size());
+    return longer.back();
+  }
+  for (double d : {opt_.approach_m / 2, opt_.approach_m / 4, opt_.approach_m / 8}) {
+    std::vector<JointVector> out = straight(d);
+    if (out.empty()) continue;
+    *length = d;
+    return out;
+  }
+  return {};
+}
+
+bool SegmentBuilder::Retreat(int action, int robot) {
+  const int node = released_[robot];
+  if (node < 0) return true;
+  if (!SetScene(opening_, {}, {}, {{robot, node}})) return false;
+  double length = 0.0;
+  std::vector<JointVector> back = BackOff(robot, cur_[robot], &length);
+  if (back.empty()) {
+    return Fail(action, SegmentKind::kRetreat, false,
+                Name(robot) + " cannot back its gripper away from " + NodeName(node) +
+                    " along the gripper axis: " + last_hit_,
+                released_at_[robot]);
+  }
+  PushSkill(SegmentKind::kRetreat, action, false, robot, node, back, length, opt_.skill_speed_mps);
+  released_[robot] = -1;
+  return true;
+}
+
+bool SegmentBuilder::Lift(int action, int node, const std::vector<int>& holders) {
+  if (!SetScene(opening_, {}, {node})) return false;
+  // Straight up; else back along the first holder's approach axis when that leaves the table
+  // upward; else up and sideways; else a shorter lift.
+  const Vec3 back = -Tcp(holders[0], cur_[holders[0]]).linear().col(2);
+  std::vector<std::pair<Vec3, double>> moves = {{Vec3::UnitZ(), opt_.lift_m}};
+  if (back.z() > 0.3) moves.push_back({back, opt_.lift_m / back.z()});
+  for (const Vec3& side :
+       std::array<Vec3, 4>{Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0)}) {
+    moves.push_back({(side + Vec3::UnitZ()).normalized(), opt_.lift_m * std::sqrt(2.0)});
+  }
+  moves.push_back({Vec3::UnitZ(), opt_.lift_m / 2});
+  std::string why;
+  for (const auto& [dir, d] : moves) {
+    std::vector<JointVector> q0;
+    std::vector<std::function<Iso3(double)>> targets;
+    for (int r : holders) {
+      q0.push_back(cur_[r]);
+      const Iso3 X0 = Tcp(r, cur_[r]);
+      targets.push_back([X0, d = d, dir = dir](double s) {
+        Iso3 X = X0;
+        X.translation() += s * d * dir;
+        return X;
+      });
+    }
+    const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
+    auto path = Track(holders, q0, targets, steps);
+    if (path.empty()) {
+      why = "no IK solution along the line";
+      continue;
+    }
+    if (!PathClear(holders, path)) {
+      why = last_hit_;
+      continue;
+    }
+    PushSkill(SegmentKind::kLift, action, true, holders, {node}, std::move(path), d,
+              opt_.skill_speed_mps);
+    grounded_.erase(node);
+    return true;
+  }
+  return Fail(action, SegmentKind::kLift, false,
+              "the holders of " + NodeName(node) + " cannot lift it off the table: " + why);
+}
+
+bool SegmentBuilder::PlanApproaches(int i, ActionWork& w) {
+  w.approaches.assign(w.graspers.size(), {});
+  w.approach_len.assign(w.graspers.size(), 0.0);
+  // Other IK solutions of each grasper's grasp (UR arms, at higher effort): where they fit the
+  // keyframe and can approach straight, the free path may end at any of them.
+  w.alternatives.assign(w.graspers.size(), {});
+  for (size_t k = 0; k < w.graspers.size(); ++k) {
+    const int r = w.graspers[k];
+    const std::vector<JointVector> options = GraspSolutions(i, r);
+    for (size_t o = 0; o < options.size(); ++o) {
+      double len = 0.0;
+      std::vector<JointVector> back;
+      if (!BackOffGrasp(i, w, r, options[o], back, len)) return false;
+      if (o > 0) {
+        if (!back.empty()) {
+          std::reverse(back.begin(), back.end());
+          w.alternatives[k].push_back({options[o], std::move(back), len});
+        }
+        continue;
+      }
+      if (back.empty()) {
+        return Fail(i, SegmentKind::kApproach, false,
+                    Name(r) + " cannot approach its grasp on " + NodeName(w.grasped) +
+                        " straight along the gripper axis: " + last_hit_);
+      }
+      std::reverse(back.begin(), back.end());
+      w.approaches[k] = std::move(back);
+      w.approach_len[k] = len;
+    }
+  }
+  return true;
+}
+
+std::vector<JointVector> SegmentBuilder::GraspSolutions(int i, int r) {
+  const Keyframe& K = plan_.actions[i].keyframe;
+  std::vector<JointVector> options = {K.q[r]};
+  const TaskRobot& tr = w_.robots[r];
+  if (effort_ >= 1 && tr.ur) {
+    const UrIkSolutions sols = tr.ur->SolveTcp(tr.X_BW * Tcp(r, K.q[r]), tr.end_effector.X_FT);
+    for (int c = 0; c < sols.count; ++c) {
+      const JointVector q = NearestEquivalent(tr.chain, sols.q[c], cur_[r]);
+      if ((NearestEquivalent(tr.chain, q, K.q[r]) - K.q[r]).cwiseAbs().maxCoeff() < 1e-6) {
+        continue;
+      }
+      if (StageAccepts(r, i, false, K.q[r], q)) options.push_back(q);
+    }
+    if (ctx_.Logs("motion")) {
+      ctx_.Log("motion", StrFormat("alternatives: action %d %s: %d IK solutions, %zu fit", i + 1,
+                                   Name(r).c_str(), sols.count, options.size() - 1));
+    }
+  }
+  return options;
+}
+
+bool SegmentBuilder::BackOffGrasp(int i, const ActionWork& w, int r, const JointVector& q,
+                                  std::vector<JointVector>& back, double& length) {
+  const Keyframe& K = plan_.actions[i].keyframe;
+  std::vector<double> openings = opening_;
+  openings[r] = GraspOpening(w_.robots[r], w.new_grasp);
+  const JointVector saved = cur_[r];
+  cur_[r] = K.q[r];
+  // The scene at the keyframe's object poses: the object to grasp where it will be.
+  PlanState at = state_;
+  for (const PlanObject& ob : K.objects) {
+    if (auto it = at.objects.find(ob.node); it != at.objects.end()) it->second.X_WA = ob.X_WA;
+  }
+  std::swap(state_, at);
+  std::vector<int> carriers_now;
+  for (const MovingObject& m : w.moving) {
+    for (int h : m.holders) {
+      carriers_now.push_back(h);
+    }
+  }
+  std::vector<JointVector> saved_carriers;
+  for (int h : carriers_now) {
+    saved_carriers.push_back(cur_[h]);
+    cur_[h] = K.q[h];
+  }
+  auto set = SetScene(openings, {}, {}, {{r, w.grasped}});
+  if (!set) return false;
+  back = BackOff(r, q, &length);
+  for (size_t c = 0; c < carriers_now.size(); ++c) cur_[carriers_now[c]] = saved_carriers[c];
+  std::swap(state_, at);
+  cur_[r] = saved;
+  return true;
+}
+
+bool SegmentBuilder::PlanPlaceDescent(int i, ActionWork& w) {
+  const PlanAction& a = plan_.actions[i];
+  const Keyframe& K = a.keyframe;
+  const int r = a.robots[0];
+  const JointVector saved = cur_[r];
+  cur_[r] = K.q[r];
+  if (!SetScene(opening_, {}, {w.grasped})) return false;
+  const Iso3 X0 = Tcp(r, K.q[r]);
+  const double d = opt_.lift_m;
+  auto path = Track({r}, {K.q[r]}, {[X0, d](double s) {
+                      Iso3 X = X0;
+                      X.translation().z() += s * d;
+                      return X;
+                    }},
+                    std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m))));
+  const bool ok = !path.empty() && PathClear({r}, path);
+  cur_[r] = saved;
+  if (!ok) {
+    return Fail(i, SegmentKind::kDescend, false,
+                Name(r) + " cannot set " + NodeName(w.grasped) +
+                    " down straight onto the table at its placement: " + last_hit_);
+  }
+  for (auto it = path.rbegin(); it != path.rend(); ++it) w.descend.push_back((*it)[0]);
+  return true;
+}
+bool SegmentBuilder::LongerSlideFree(int step, double extra) {
+  if (step < w_.num_parts || !w_.check || !w_.check->tree) return true;
+  if (!geometry_) geometry_.emplace(AssemblyGeometry::FromProject(*w_.project, *w_.check));
+  InsertionPath path =
+      StepInsertionPath(*w_.project, *w_.check->tree, w_.tree->nodes[step].step, -1);
+  path.length_m += extra;
+  return IsPathFree(*geometry_, path);
+}
+
+void SegmentBuilder::SlideStart(int action, Keyframe& goal) {
+  const PlanAction& a = plan_.actions[action];
+  if (a.type != ActionType::kAssemble || !a.approach || a.objects.size() < 2) return;
+  const int m_node = a.objects[0], b_node = a.objects[1];
+  const std::vector<int> holders = state_.Holders(m_node);
+  if (holders.empty()) return;
+  const int h0 = holders[0];
+  const bool clear = KeyframeAccepts(h0, goal.q[h0], goal, {});
+  if (clear && !Tight(h0, goal.q[h0])) return;  // clear, with room around it
+  if (!clear && !KeyframeAccepts(h0, goal.q[h0], goal, {{m_node, b_node}})) return;  // not that
+  Vec3 u = Tcp(h0, goal.q[h0]).translation() - Tcp(h0, a.keyframe.q[h0]).translation();
+  if (u.norm() < 1e-6) return;
+  u.normalize();
+  std::vector<JointVector> q0;
+  for (int r : holders) q0.push_back(goal.q[r]);
+  // Further back along the insertion line: the first start that is clear with room around it
+  // (a free path hardly reaches a start in a pocket, e.g. a long bolt still near its hole);
+  // else the first clear one when the approach keyframe touches the base.
+  std::optional<Keyframe> first_clear;
+  double first_extra = 0.0;
+  for (double extra : {0.01, 0.02, 0.04, 0.06, 0.09, 0.12}) {
+    if (a.objects.size() >= 3 && !LongerSlideFree(a.objects[2], extra)) break;
+    std::vector<std::function<Iso3(double)>> targets;
+    for (int r : holders) {
+      const Iso3 Xa = Tcp(r, goal.q[r]);
+      targets.push_back([Xa, u, extra](double s) {
+        Iso3 X = Xa;
+        X.translation() += s * extra * u;
+        return X;
+      });
+    }
+    const int steps = std::max(2, static_cast<int>(std::ceil(extra / opt_.cartesian_step_m)));
+    const auto path = Track(holders, q0, targets, steps);
+    if (path.empty()) continue;
+    Keyframe pre = goal;
+    for (size_t k = 0; k < holders.size(); ++k) pre.q[holders[k]] = path.back()[k];
+    for (PlanObject& o : pre.objects) {
+      if (o.node == m_node) o.X_WA.translation() += extra * u;
+    }
+    if (!KeyframeAccepts(h0, pre.q[h0], pre, {})) continue;
+    if (!Tight(h0, pre.q[h0])) {
+      if (ctx_.Logs("motion")) {
+        ctx_.Log("motion",
+                 StrFormat("slide: action %d: %s %s %s at the approach; the slide starts %.0f mm "
+                           "further back",
+                           action + 1, NodeName(m_node).c_str(), clear ? "is close to" : "touches",
+                           NodeName(b_node).c_str(), 1000.0 * extra));
+      }
+      goal = std::move(pre);
+      return;
+    }
+    if (!clear && !first_clear) {
+      first_clear = std::move(pre);
+      first_extra = extra;
+    }
+  }
+  if (first_clear) {
+    if (ctx_.Logs("motion")) {
+      ctx_.Log("motion",
+               StrFormat("slide: action %d: %s touches %s at the approach; the slide starts "
+                         "%.0f mm further back (still tight)",
+                         action + 1, NodeName(m_node).c_str(), NodeName(b_node).c_str(),
+                         1000.0 * first_extra));
+    }
+    goal = std::move(*first_clear);
+  }
+}
+
+bool SegmentBuilder::HoverAbove(int action, Keyframe& goal, std::vector<int>& holders,
+                                std::vector<std::vector<JointVector>>& descent, double* length) {
+  // An input this close above the table top touches it [m].
+  constexpr double kTouch = 2e-3;
+  const PlanAction& a = plan_.actions[action];
+  if (a.objects.size() < 2) return true;
+  const int m_node = a.objects[0], b_node = a.objects[1];
+  const PlanObject* mo = FindObject(goal, m_node);
+  if (mo == nullptr || LowestPoint(w_, m_node, mo->X_WA) > w_.table_top + kTouch) return true;
+  holders = state_.Holders(m_node);
+  if (holders.empty()) return true;
+  // The scene at the goal: the objects where the keyframe has them, every robot at its joints.
+  PlanState at = state_;
+  for (const PlanObject& o : goal.objects) {
+    if (auto it = at.objects.find(o.node); it != at.objects.end()) it->second.X_WA = o.X_WA;
+  }
+  std::vector<JointVector> q0;
+  for (int r : holders) q0.push_back(goal.q[r]);
+  // Straight down onto the table; else down and forward along the slide (from above and behind
+  // its start), where the space above the start is taken.
+  std::vector<Vec3> dirs = {Vec3::UnitZ()};
+  Vec3 back = Tcp(holders[0], goal.q[holders[0]]).translation() -
+              Tcp(holders[0], a.keyframe.q[holders[0]]).translation();
+  back.z() = 0.0;
+  if (back.norm() > 1e-6) dirs.push_back((Vec3::UnitZ() + back.normalized()).normalized());
+  std::string why = "no IK solution along the line";
+  for (const Vec3& dir : dirs) {
+    for (double d : {opt_.lift_m, 2 * opt_.lift_m, opt_.lift_m / 2}) {
+      const double len = d / dir.z();
+      std::vector<std::function<Iso3(double)>> targets;
+      for (int r : holders) {
+        const Iso3 X0 = Tcp(r, goal.q[r]);
+        targets.push_back([X0, dir, len](double s) {
+          Iso3 X = X0;
+          X.translation() += s * len * dir;
+          return X;
+        });
+      }
+      auto path = Track(holders, q0, targets,
+                        std::max(2, static_cast<int>(std::ceil(len / opt_.cartesian_step_m))));
+      if (path.empty()) continue;
+      Keyframe top = goal;
+      for (size_t k = 0; k < holders.size(); ++k) top.q[holders[k]] = path.back()[k];
+      for (PlanObject& o : top.objects) {
+        if (o.node == m_node) o.X_WA.translation() += len * dir;
+      }
+      if (!KeyframeAccepts(holders[0], top.q[holders[0]], top, {})) {
+        why = "the pose " + std::to_string(static_cast<int>(std::lround(d * 1000))) +
+              " mm above it collides";
+        continue;
+      }
+      // The way down may touch the table and the base (the slide's contacts).
+      if (!scene_.Set(at, opening_, goal.q, {{m_node, b_node}}, {m_node})) return false;
+      if (!PathClear(holders, path)) {
+        why = last_hit_;
+        continue;
+      }
+      if (ctx_.Logs("motion")) {
+        ctx_.Log("motion",
+                 StrFormat("hover: action %d: %s touches the table at the insertion's start; it "
+                           "is lowered %.0f mm onto it",
+                           action + 1, NodeName(m_node).c_str(), 1000.0 * d));
+      }
+      descent.assign(path.rbegin(), path.rend());
+      *length = len;
+      goal = std::move(top);
+      return true;
+    }
+  }
+  return Fail(action, SegmentKind::kDescend, false,
+              "the holders of " + NodeName(m_node) +
+                  " cannot lower it straight onto the table where its insertion starts: " + why);
+}
+
+bool SegmentBuilder::Insert(int i) {
+  const PlanAction& a = plan_.actions[i];
+  const Keyframe& K = a.keyframe;
+  const int m_node = a.objects[0];
+  const int b_node = a.objects[1];
+  std::vector<int> inserters = state_.Holders(m_node);
+  std::vector<JointVector> q0;
+  std::vector<std::function<Iso3(double)>> targets;
+  double len = 0.0;
+  for (int r : inserters) {
+    q0.push_back(cur_[r]);
+    const Iso3 Xa = Tcp(r, cur_[r]);
+    const Iso3 Xb = Tcp(r, K.q[r]);
+    len = std::max(len, (Xb.translation() - Xa.translation()).norm());
+    targets.push_back([Xa, Xb](double s) {
+      Iso3 X = Xa;
+      X.translation() = (1 - s) * Xa.translation() + s * Xb.translation();
+      return X;
+    });
+  }
+  const int steps = std::max(2, static_cast<int>(std::ceil(len / opt_.cartesian_step_m)));
+  std::vector<JointVector> goals;
+  for (int r : inserters) goals.push_back(K.q[r]);
+  auto path = Track(inserters, q0, targets, steps, &goals);
+  bool ok = !path.empty();
+  for (size_t k = 0; ok && k < inserters.size(); ++k) {
+    const int r = inserters[k];
+    if ((path.back()[k] - K.q[r]).cwiseAbs().maxCoeff() > kMaxSnap) {
+      ok = KeyframeAccepts(r, path.back()[k], K, {{m_node, b_node}});
+      if (ok) Rebranch(r, i, false, K.q[r], path.back()[k]);
+    }
+    if (ok) path.back()[k] = K.q[r];
+  }
+  if (ok) {
+    if (!SetScene(opening_, {{m_node, b_node}}, {m_node})) return false;
+    ok = PathClear(inserters, path);
+  }
+  if (!ok) {
+    return Fail(i, SegmentKind::kInsert, false,
+                "the insertion of " + NodeName(m_node) + " into " + NodeName(b_node) +
+                    " is not a collision-free straight move: " + last_hit_);
+  }
+  PushSkill(SegmentKind::kInsert, i, true, inserters, {m_node, b_node}, std::move(path), len,
+            opt_.insert_speed_mps);
+  return true;
+}
+}  // namespace wrap::detail
