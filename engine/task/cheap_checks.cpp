@@ -11,22 +11,33 @@
 
 namespace wrap {
 
-bool TaskSearch::Recall(std::uint64_t key, const CheapAnswer& answer) {
+bool TaskSearch::Recall(CheapAnswer& answer) {
   // Counted once per milestone: the tally counts distinct questions, not how often the search
   // met them.
-  if (!answer.ok && tallied_.insert(key).second) tally_.Add(answer.gate, answer.why, answer.about);
+  if (!answer.ok && answer.tallied_round != tally_round_) {
+    answer.tallied_round = tally_round_;
+    tally_.Add(answer.gate, answer.why, answer.about);
+  }
   return answer.ok;
 }
 
 void TaskSearch::Remember(std::uint64_t key, bool ok) {
-  tallied_.insert(key);
-  cheap_[key] = ok ? CheapAnswer{}
-                   : CheapAnswer{false, tally_.last_gate, tally_.last_message, tally_.last_subject};
+  CheapAnswer answer;
+  if (!ok) {
+    answer = CheapAnswer{false, tally_.last_gate, tally_.last_message, tally_.last_subject};
+  }
+  answer.tallied_round = tally_round_;
+  if (int* index = cheap_.find(key)) {
+    cheap_answers_[*index] = std::move(answer);
+  } else {
+    cheap_.try_emplace(key, static_cast<int>(cheap_answers_.size()));
+    cheap_answers_.push_back(std::move(answer));
+  }
 }
 
 bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
   std::uint64_t key = HashMix(HashMix(HashMix(HashMix(101, robot), node), loc), grasp);
-  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(key, it->second);
+  if (int* index = cheap_.find(key)) return Recall(cheap_answers_[*index]);
   const Iso3 X_WA = tables_.location(loc).X_WA;
   const Iso3 target = solver_.GraspTarget(X_WA, grasp);
   bool ok = solver_.InReach(robot, target);
@@ -132,7 +143,7 @@ bool TaskSearch::HomesClear(int node, int loc) {
 
 bool TaskSearch::CheapPlace(int robot, int node, int loc, int grasp) {
   std::uint64_t key = HashMix(HashMix(HashMix(HashMix(102, robot), node), loc), grasp);
-  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(key, it->second);
+  if (int* index = cheap_.find(key)) return Recall(cheap_answers_[*index]);
   const Iso3 X_WA = tables_.location(loc).X_WA;
   const Iso3 target = solver_.GraspTarget(X_WA, grasp);
   bool ok = solver_.InReach(robot, target);
@@ -189,7 +200,7 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
   }
   const bool b_rests = s.loc[m.base] >= 0;
   const std::uint64_t key = CheapAssembleKey(m.step, b_rests ? s.loc[m.base] : -1, mh, bh);
-  if (auto it = cheap_.find(key); it != cheap_.end()) return Recall(key, it->second);
+  if (int* index = cheap_.find(key)) return Recall(cheap_answers_[*index]);
   bool ok = true;
   std::string why;
   // What the checks are about: the moved input where it is mated (on the resting base, or at

@@ -48,14 +48,14 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(
     const std::unordered_set<std::uint64_t>& forbidden, long long node_budget, int g0, int max_cost,
     std::vector<int>& path) {
   nodes_.clear();
-  std::unordered_map<std::uint64_t, int> best_g;
+  FlatMap<int> best_g;
   using Entry = std::tuple<int, int, long long, int>;  // f, -g, sequence, node
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
   long long sequence = 0;
   const int h0 = Heuristic(s0, m);
   if (g0 + h0 > max_cost) return SearchStatus::kExhausted;
-  nodes_.push_back({s0, 0, -1, {}});
-  best_g[s0.Hash()] = 0;
+  nodes_.push_back({s0, 0, -1, {}, s0.Hash()});
+  best_g[nodes_.back().hash] = 0;
   open.push({weight_ * h0, 0, sequence++, 0});
   const std::size_t memory_limit = static_cast<std::size_t>(options_.memory_limit_mb) << 20;
   SuccessorList successors;
@@ -75,7 +75,7 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(
     const auto [f, neg_g, seq, index] = open.top();
     open.pop();
     const int g = nodes_[index].g;
-    const std::uint64_t h = nodes_[index].s.Hash();
+    const std::uint64_t h = nodes_[index].hash;
     if (best_g[h] < g) continue;
     if (IsGoal(nodes_[index].s, m, excluded)) {
       path.clear();
@@ -87,22 +87,22 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(
     const SymState s = nodes_[index].s;
     Successors(s, m, res, successors);
     for (auto& [a, s2] : successors) {
-      const std::uint64_t edge = EdgeKey(s, a);
-      auto failed = failed_level_.find(edge);
-      if (failed != failed_level_.end() && failed->second >= effort) continue;
+      const std::uint64_t edge = EdgeKey(h, a);
+      const int* failed = failed_level_.find(edge);
+      if (failed && *failed >= effort) continue;
       if (!dead_ends.empty() && dead_ends.contains(edge)) continue;
       const int g2 = g + 1;
       const std::uint64_t h2 = s2.Hash();
       if (!forbidden.empty() && forbidden.contains(h2)) continue;
-      auto [it, inserted] = best_g.try_emplace(h2, g2);
+      auto [best, inserted] = best_g.try_emplace(h2, g2);
       if (!inserted) {
-        if (it->second <= g2) continue;
-        it->second = g2;
+        if (*best <= g2) continue;
+        *best = g2;
       }
       const int hv = Heuristic(s2, m);
       if (g0 + g2 + hv > max_cost) continue;  // plan improvement: cannot beat the bound
       const int child = static_cast<int>(nodes_.size());
-      nodes_.push_back({std::move(s2), g2, index, a});
+      nodes_.push_back({std::move(s2), g2, index, a, h2});
       open.push({g2 + weight_ * hv, -g2, sequence++, child});
     }
   }
@@ -215,8 +215,8 @@ TaskSearch::CandidateStatus TaskSearch::CommitCandidate(
     const std::uint64_t witness_key = HashMix(c.Fingerprint(s), a.Hash());
     auto w = witnesses_.find(witness_key);
     if (w == witnesses_.end()) {
-      auto failed = failed_level_.find(edge);
-      const int edge_level = failed == failed_level_.end() ? 0 : failed->second + 1;
+      const int* failed = failed_level_.find(edge);
+      const int edge_level = failed ? *failed + 1 : 0;
       // The first failure of each collision-like gate in a milestone keeps its picture.
       solver_.set_explain(tally_.count[static_cast<int>(Gate::kCollision)] == 0 ||
                           tally_.count[static_cast<int>(Gate::kSkill)] == 0 ||

@@ -167,7 +167,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   const Milestone m = StepMilestone(step, next_step);
   weight_ = limits.weight >= 0 ? limits.weight : default_weight_;
   tally_ = GateTally{};
-  tallied_.clear();
+  ++tally_round_;
   fill_failures_ = 0;
   MilestoneResult result;
   const std::string words = "milestone " + std::to_string(index + 1) + " " + StepWords(step);

@@ -18,6 +18,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "core/flat_map.h"
 #include "core/run_context.h"
 #include "task/failure.h"
 #include "task/keyframes.h"
@@ -153,6 +154,7 @@ class TaskSearch {
     int g = 0;
     int parent = -1;
     TaskAction a;
+    std::uint64_t hash = 0;  ///< s.Hash(), computed once (the search's hot path).
   };
   enum class SearchStatus { kFound, kExhausted, kNodeLimit, kStopped, kOutOfMemory };
   /// Actions of a state with the states they lead to.
@@ -325,20 +327,35 @@ class TaskSearch {
   int WindowDone(const SymState& s) const;
   std::vector<Node> nodes_;
   std::map<std::pair<int, int>, std::vector<int>> grasp_ids_;
-  std::unordered_map<std::uint64_t, int> failed_level_;       // edge key -> level failed at
+  FlatMap<int> failed_level_;                                 // edge key -> level failed at
   std::unordered_map<std::uint64_t, EdgeOutcome> witnesses_;  // continuous edge key -> outcome
   struct CheapAnswer {
     bool ok = true;
     Gate gate = Gate::kNone;
     std::string why;
     CheckSubject about;
+    int tallied_round = -1;  ///< The tally round (milestone) that last counted this failure.
   };
-  bool Recall(std::uint64_t key, const CheapAnswer& answer);  // tallies a cached failure once
-  void Remember(std::uint64_t key, bool ok);                  // caches with the last tallied reason
-  std::unordered_map<std::uint64_t, CheapAnswer> cheap_;      // cheap-check answers
-  std::unordered_set<std::uint64_t> tallied_;            // cheap failures tallied in this milestone
+  bool Recall(CheapAnswer& answer);           // tallies a cached failure once per tally round
+  void Remember(std::uint64_t key, bool ok);  // caches with the last tallied reason
+  // Cheap-check answers: question key -> index into cheap_answers_.
+  FlatMap<int> cheap_;
+  std::vector<CheapAnswer> cheap_answers_;
+  // Cheap failures are tallied once per round (a milestone, or a window of plan improvement):
+  // a CheapAnswer counted in this round has tallied_round == tally_round_.
+  int tally_round_ = 0;
   std::unordered_map<std::uint64_t, bool> homes_clear_;  // HomesClear per (node, location)
   std::unordered_map<std::uint64_t, bool> hands_apart_;  // HandsApart answers
+  // What GraspsApart reads of a grasp (by grasp id), computed once: its TCP position and
+  // approach axis in the assembly frame, and whether its object is small (under 15 cm across).
+  struct GraspAxis {
+    Vec3 p_A = Vec3::Zero();
+    Vec3 z_A = Vec3::Zero();
+    bool small = false;
+    bool known = false;
+  };
+  const GraspAxis& AxisOf(int grasp) const;
+  mutable std::vector<GraspAxis> grasp_axes_;
   std::map<int, std::pair<bool, std::string>> possible_;  // AssemblyPossible per step
   std::vector<Iso3> placement_pose_;                      // scratch
   long long expansions_ = 0;

@@ -12,9 +12,14 @@ namespace wrap {
 /// TaskSearch's failed-level mark of an edge that fails at every effort level (or is banned).
 inline constexpr int kPermanentFailure = INT_MAX;
 
+/// The key of the symbolic edge taking action `a` from a state whose SymState::Hash is `s_hash`.
+inline std::uint64_t EdgeKey(std::uint64_t s_hash, const TaskAction& a) {
+  return HashMix(s_hash, a.Hash());
+}
+
 /// The key of the symbolic edge taking action `a` from `s` (PlanAction::edge).
 inline std::uint64_t EdgeKey(const SymState& s, const TaskAction& a) {
-  return HashMix(s.Hash(), a.Hash());
+  return EdgeKey(s.Hash(), a);
 }
 
 }  // namespace wrap

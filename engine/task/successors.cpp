@@ -25,17 +25,29 @@ const std::vector<int>& TaskSearch::GraspIds(int node, int robot) {
   return it->second;
 }
 
+const TaskSearch::GraspAxis& TaskSearch::AxisOf(int grasp) const {
+  if (grasp >= static_cast<int>(grasp_axes_.size())) grasp_axes_.resize(grasp + 1);
+  GraspAxis& axis = grasp_axes_[grasp];
+  if (!axis.known) {
+    const GraspRef& g = tables_.grasp(grasp);
+    const Iso3 X_AG = world_.X_AP[g.part] * g.X_PG;
+    axis.p_A = X_AG.translation();
+    axis.z_A = X_AG.linear().col(2);
+    const Aabb& box = world_.pre->subassemblies[g.subassembly].aabb_A;
+    axis.small = (box.max - box.min).norm() < 0.15;
+    axis.known = true;
+  }
+  return axis;
+}
+
 bool TaskSearch::GraspsApart(int grasp_a, int grasp_b) const {
-  const GraspRef& a = tables_.grasp(grasp_a);
-  const GraspRef& b = tables_.grasp(grasp_b);
-  const Iso3 X_AGa = world_.X_AP[a.part] * a.X_PG;
-  const Iso3 X_AGb = world_.X_AP[b.part] * b.X_PG;
-  if ((X_AGa.translation() - X_AGb.translation()).norm() < 0.04) return false;
+  const GraspAxis& a = AxisOf(grasp_a);
+  const GraspAxis& b = AxisOf(grasp_b);
+  if ((a.p_A - b.p_A).norm() < 0.04) return false;
   // Two grippers coming from nearly the same side of an object collide; on a small object
   // (under 15 cm across) they need to come from opposite sides.
-  const Aabb& box = world_.pre->subassemblies[a.subassembly].aabb_A;
-  const double limit = (box.max - box.min).norm() < 0.15 ? 0.0 : 0.5;
-  return X_AGa.linear().col(2).dot(X_AGb.linear().col(2)) < limit;
+  const double limit = a.small ? 0.0 : 0.5;
+  return a.z_A.dot(b.z_A) < limit;
 }
 
 bool TaskSearch::HandsApart(int robot_a, int grasp_a, int robot_b, int grasp_b) {

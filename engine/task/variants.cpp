@@ -90,7 +90,7 @@ MilestoneResult TaskSearch::FillWindow(int index, const std::vector<int>& steps,
   m.flat = true;
   weight_ = limits.weight >= 0 ? limits.weight : default_weight_;
   tally_ = GateTally{};
-  tallied_.clear();
+  ++tally_round_;
   fill_failures_ = 0;
   MilestoneResult result;
   const int levels = 3;
@@ -111,7 +111,7 @@ MilestoneResult TaskSearch::FillFlat(const SymState& s0, const ContState& c0) {
   m.flat = true;
   weight_ = default_weight_;
   tally_ = GateTally{};
-  tallied_.clear();
+  ++tally_round_;
   fill_failures_ = 0;
   MilestoneResult result;
   for (int step : flat_order_) {

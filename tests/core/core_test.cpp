@@ -1,13 +1,17 @@
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <numbers>
+#include <random>
 #include <string>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "core/diagnostics.h"
 #include "core/file_io.h"
+#include "core/flat_map.h"
 #include "core/pose.h"
 #include "core/result.h"
 #include "core/run_context.h"
@@ -188,6 +192,50 @@ TEST(RunContext, StageTimerAccumulates) {
   { ScopedStageTimer t(ctx, "grasp"); }
   ASSERT_EQ(ctx.stage_times().count("grasp"), 1u);
   EXPECT_GE(ctx.stage_times().at("grasp"), 0.0);
+}
+
+// FlatMap answers like std::unordered_map over random inserts and lookups, through its growth
+// and a clear, with keys that share their low bits or their high bits (the probe's worst cases).
+TEST(FlatMap, AgreesWithUnorderedMap) {
+  std::mt19937_64 rng(5);
+  FlatMap<int> flat;
+  std::unordered_map<std::uint64_t, int> reference;
+  auto key_of = [&](int k) -> std::uint64_t {
+    switch (k % 3) {
+      case 0:
+        return rng() % 5000;  // small keys, many repeats
+      case 1:
+        return (rng() % 5000) << 40;  // low bits all zero
+      default:
+        return rng() | 0x8000000000000000ULL;  // anything
+    }
+  };
+  for (int round = 0; round < 2; ++round) {
+    for (int k = 0; k < 20000; ++k) {
+      const std::uint64_t key = key_of(k);
+      const int value = static_cast<int>(rng() % 1000);
+      const auto [it, inserted] = reference.try_emplace(key, value);
+      const auto [v, flat_inserted] = flat.try_emplace(key, value);
+      ASSERT_EQ(flat_inserted, inserted) << key;
+      ASSERT_EQ(*v, it->second) << key;
+      if (k % 7 == 0) {
+        flat[key] = k;
+        it->second = k;
+      }
+      const std::uint64_t probe = key_of(k + 1);
+      const int* found = flat.find(probe);
+      const auto ref = reference.find(probe);
+      ASSERT_EQ(found != nullptr, ref != reference.end()) << probe;
+      if (found) {
+        ASSERT_EQ(*found, ref->second);
+      }
+    }
+    EXPECT_EQ(flat.size(), reference.size());
+    flat.clear();
+    reference.clear();
+    EXPECT_TRUE(flat.empty());
+    EXPECT_FALSE(flat.contains(0));
+  }
 }
 
 }  // namespace
