@@ -122,13 +122,13 @@ TEST(PlannerFeedback, BannedEdgesAreNotTaken) {
   const fs::path file = ProjectFile("stool");
   const LoadedProject lp = LoadProject(file);
   ASSERT_TRUE(lp.ok());
-  const PlanRun a = PlanAndValidate(*lp.project, lp.check, file, 3, 120.0);
+  const PlanRun a = PlanAndValidate(*lp.project, lp.check, file, 3, kNoTimeLimit);
   ASSERT_TRUE(a.plan && a.plan->stats.solved);
   const std::uint64_t banned = a.plan->actions.front().edge;
   ASSERT_NE(banned, 0u);
   TaskPlannerOptions options;
   options.banned_edges = {banned};
-  const PlanRun b = PlanAndValidate(*lp.project, lp.check, file, 3, 120.0, options);
+  const PlanRun b = PlanAndValidate(*lp.project, lp.check, file, 3, kNoTimeLimit, options);
   ASSERT_TRUE(b.plan && b.plan->stats.solved) << (b.plan ? b.plan->stats.failure : "");
   ASSERT_TRUE(b.validation);
   EXPECT_TRUE(b.validation->valid) << Issues(*b.validation);
@@ -148,7 +148,7 @@ TEST_P(ExamplePlan, IsSolvedAndValid) {
     GTEST_SKIP() << "the Fabrica meshes are not beside the repository (../shared/fabrica)";
   }
   ASSERT_TRUE(lp.ok()) << GetParam();
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 240.0);
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, kNoTimeLimit);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   const Plan& plan = *run.plan;
   ASSERT_TRUE(plan.stats.solved) << GetParam() << ": " << plan.stats.failure;
@@ -182,7 +182,7 @@ TEST(WrapPlanInfeasible, FabricaCarPhysicalDagSaysWhereItFails) {
   const fs::path file = ProjectFile("fabrica_car");
   const LoadedProject lp = LoadProject(file);
   if (!lp.ok()) GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 120.0, {});
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, kNoTimeLimit, {});
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   const PlanStats& st = run.plan->stats;
   ASSERT_FALSE(st.solved) << "fabrica_car plans now: put it back among the ExamplePlan projects";
@@ -213,7 +213,7 @@ TEST(WrapPlanInfeasible, NoAssemblyGraspIsExplained) {
   options.wrench_mode = MatingWrenchMode::kNone;
   options.project_file = file;
   RunContext plan_ctx(0);
-  plan_ctx.set_time_limit_s(60.0);
+  plan_ctx.set_time_limit_s(kNoTimeLimit);
   auto plan = PlanTask(*lp.project, lp.check, *pre, options, plan_ctx);
   ASSERT_TRUE(plan.has_value()) << plan.error().message;
   EXPECT_FALSE(plan->stats.solved);
@@ -237,7 +237,7 @@ TEST_P(CrossRobots, IsSolvedAndValid) {
   project.robots.resize(GetParam());
   const ProjectCheck check = ValidateProject(project, file);
   ASSERT_FALSE(check.diagnostics.has_errors());
-  const PlanRun run = PlanAndValidate(project, check, file, 0, 240.0);
+  const PlanRun run = PlanAndValidate(project, check, file, 0, kNoTimeLimit);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   ASSERT_TRUE(run.plan->stats.solved) << run.plan->stats.failure;
   ASSERT_TRUE(run.validation.has_value());
@@ -262,8 +262,8 @@ TEST(PlannerDeterminism, SameSeedSamePlan) {
     for (auto& [t, cost] : s.cost_history) t = 0.0;
     return SerializePlan(plan);
   };
-  const PlanRun a = PlanAndValidate(*lp.project, lp.check, file, 7, 120.0);
-  const PlanRun b = PlanAndValidate(*lp.project, lp.check, file, 7, 120.0);
+  const PlanRun a = PlanAndValidate(*lp.project, lp.check, file, 7, kNoTimeLimit);
+  const PlanRun b = PlanAndValidate(*lp.project, lp.check, file, 7, kNoTimeLimit);
   ASSERT_TRUE(a.plan && b.plan);
   ASSERT_TRUE(a.plan->stats.solved);
   EXPECT_EQ(strip(*a.plan), strip(*b.plan));
@@ -281,7 +281,7 @@ TEST(PlannerInfeasible, VacuumOnlyTransverseForceNamesTheStep) {
   project.steps[0].mating.offset_m = 0.01;
   const ProjectCheck check = ValidateProject(project, file);
   ASSERT_FALSE(check.diagnostics.has_errors());
-  const PlanRun run = PlanAndValidate(project, check, file, 0, 120.0);
+  const PlanRun run = PlanAndValidate(project, check, file, 0, kNoTimeLimit);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   EXPECT_FALSE(run.plan->stats.solved);
   EXPECT_NE(run.plan->stats.failure.find("seat+leg1"), std::string::npos)
@@ -323,7 +323,7 @@ TEST(PlannerInfeasible, TheReportsChecksSayWhatWasTried) {
   options.planner = PlannerVariant::kCounting;
   options.project_file = file;
   RunContext ctx(0);
-  ctx.set_time_limit_s(120.0);
+  ctx.set_time_limit_s(kNoTimeLimit);
   auto plan = PlanTask(project, check, *pre, options, ctx);
   ASSERT_TRUE(plan.has_value()) << plan.error().message;
   ASSERT_FALSE(plan->stats.solved);
@@ -372,7 +372,7 @@ TEST(PlannerInfeasible, SameProjectPlansWithoutTheWrenchModel) {
   ASSERT_TRUE(lp.ok());
   TaskPlannerOptions options;
   options.wrench_mode = MatingWrenchMode::kNone;
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 120.0, options);
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, kNoTimeLimit, options);
   ASSERT_TRUE(run.plan.has_value());
   ASSERT_TRUE(run.plan->stats.solved) << run.plan->stats.failure;
   EXPECT_EQ(run.plan->stats.wrench_mode, "none");
@@ -386,7 +386,7 @@ TEST(PlannerStats, WrenchCountersAddUp) {
   const fs::path file = ProjectFile("cross");
   const LoadedProject lp = LoadProject(file);
   ASSERT_TRUE(lp.ok());
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 120.0, {});
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, kNoTimeLimit, {});
   ASSERT_TRUE(run.plan.has_value());
   const PlanStats& st = run.plan->stats;
   ASSERT_TRUE(st.solved) << st.failure;

@@ -56,7 +56,7 @@ TEST_P(VariantPlan, IsSolvedValidAndDeterministic) {
   ASSERT_TRUE(lp.ok()) << project;
   TaskPlannerOptions options;
   options.planner = Variant(variant);
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 3, 240.0, options);
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 3, kNoTimeLimit, options);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   const PlanStats& st = run.plan->stats;
   ASSERT_TRUE(st.solved) << GetParam() << ": " << st.failure;
@@ -82,7 +82,7 @@ TEST_P(VariantPlan, IsSolvedValidAndDeterministic) {
     }
   }
   // Same seed, same plan.
-  const PlanRun again = PlanAndValidate(*lp.project, lp.check, file, 3, 240.0, options);
+  const PlanRun again = PlanAndValidate(*lp.project, lp.check, file, 3, kNoTimeLimit, options);
   ASSERT_TRUE(again.plan.has_value());
   EXPECT_EQ(WithoutTimes(*run.plan), WithoutTimes(*again.plan));
 }
@@ -110,7 +110,7 @@ TEST_P(WrapPlan, IsSolvedAndValid) {
   ASSERT_TRUE(lp.ok()) << project;
   TaskPlannerOptions options;
   options.planner = Variant(variant);
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 240.0, options);
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, kNoTimeLimit, options);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   ASSERT_TRUE(run.plan->stats.solved) << GetParam() << ": " << run.plan->stats.failure;
   ASSERT_TRUE(run.validation.has_value());
@@ -132,7 +132,7 @@ TEST(FlatLazy, StopsAtTheMemoryLimitAndSaysSo) {
     TaskPlannerOptions options;
     options.planner = PlannerVariant::kFlat;
     options.memory_limit_mb = 16;
-    const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 120.0, options);
+    const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, kNoTimeLimit, options);
     ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
     const PlanStats& st = run.plan->stats;
     EXPECT_FALSE(st.solved) << project;
@@ -154,7 +154,7 @@ struct SearchRig : SolverRig {
   bool Build(const std::string& project, const std::vector<PlannerVariant>& variants) {
     if (!SolverRig::Build(project).empty()) return false;
     ctx.emplace(0);
-    ctx->set_time_limit_s(120.0);
+    ctx->set_time_limit_s(kNoTimeLimit);
     variant_options.reserve(variants.size());  // searches keep references into it
     for (PlannerVariant v : variants) {
       variant_options.push_back(options);
