@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <random>
 #include <string>
@@ -35,7 +36,7 @@ enum class Gate {
   kWrenchTransport,
   kWrenchRelease,
   kWrenchRest,
-  kSkill,  ///< No room for a straight approach, retreat or descent at the keyframe.
+  kSkill,         ///< No room for a straight approach, retreat or descent at the keyframe.
   kGripperTable,  ///< A grasp that puts the gripper into the table where the object rests.
 };
 /// Words for a gate, e.g. "IK", "collision", "wrench (assembly)".
@@ -154,7 +155,47 @@ class KeyframeSolver {
     int node = -1;
     int grasp = -1;
   };
-  struct Attempt;
+  struct Edge;     // The edge under validation (keyframes_internal.h).
+  struct Problem;  // Its keyframe problem, built per action type.
+  struct Attempt;  // The search for its keyframe.
+
+  // The keyframe problem of each action type (keyframe_actions.cpp).
+  void BuildProblem(Edge& e, Problem& p);
+  void BuildPick(Edge& e, Problem& p);
+  void BuildPlace(Edge& e, Problem& p);
+  void BuildHandover(Edge& e, Problem& p);
+  void BuildAddGrasp(Edge& e, Problem& p);
+  void BuildRelease(Edge& e, Problem& p);
+  void BuildAssemble(Edge& e, Problem& p);
+
+  // The search for the keyframe (keyframe_validate.cpp).
+  /// The candidate object poses (node-indexed), best first; those below the table are noted.
+  std::vector<std::vector<Iso3>> Candidates(Edge& e, Problem& p, Attempt& t);
+  /// Tests the candidate t.X: wrench gates, every mover's IK, then the combinations of IK
+  /// solutions until one passes the keyframe's checks (true, t.chosen) or none does (noted).
+  bool TryCandidate(Edge& e, const Problem& p, Attempt& t);
+  /// Every mover's IK solutions at t.X in `sols`; false (noted) when one has none.
+  bool SolveMovers(Edge& e, const Problem& p, Attempt& t,
+                   std::vector<std::vector<JointVector>>& sols);
+  EdgeOutcome Failed(const Problem& p, Attempt& t);
+  EdgeOutcome Succeeded(const Edge& e, const Problem& p, Attempt& t);
+
+  // The checks of a keyframe candidate, its movers at `q` (keyframe_checks.cpp); false with
+  // t.gate and t.message.
+  /// The cell as set puts two robots closer than the minimum clearance.
+  bool RobotsTooClose();
+  /// All of the checks below, in order, with the robots' clearance first.
+  bool KeyframeClear(Edge& e, const Problem& p, Attempt& t, const std::vector<JointVector>& q);
+  /// Each new grasp's straight approach, each freed gripper's retreat, a placement's descent.
+  bool SkillsClear(const Edge& e, const Problem& p, Attempt& t, const std::vector<JointVector>& q);
+  /// Each object held by two robots or more and reposed can be carried to its new pose.
+  bool CarriesClear(const Edge& e, const Problem& p, Attempt& t, const std::vector<JointVector>& q);
+  /// The freed robots can go home, or else stay with the gripper open (t.park_home).
+  bool FreedRobotsClear(const Edge& e, const Problem& p, Attempt& t,
+                        const std::vector<JointVector>& q);
+  /// Assemble: the insertion from the approach pose is reachable and clear (t.approach).
+  bool InsertionClear(Edge& e, const Problem& p, Attempt& t, const std::vector<JointVector>& q);
+
   /// The checker's answer for `config` at `gate` (cached by `key`, 0: by content), counted in
   /// the counters (checks, hits, LPs, pivots, t_lp).
   Result<WrenchCheck> CountedCheck(WrenchGate gate, std::uint64_t key,
@@ -166,6 +207,8 @@ class KeyframeSolver {
   void SetRobot(int robot, const JointVector& q);
   void EnableRobot(int robot, bool on);
   bool Collides();
+  /// Depth first over the movers' IK solutions from `depth` on, skipping those that collide
+  /// (gate: collision), until `leaf` accepts a combination (in `chosen`) or kMaxLeaves are tried.
   bool Search(const std::vector<Mover>& movers, const std::vector<std::vector<JointVector>>& sols,
               size_t depth, std::vector<JointVector>& chosen, int& leaves, Gate& gate,
               const std::function<bool(std::vector<JointVector>&)>& leaf);
