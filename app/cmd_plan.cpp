@@ -127,37 +127,34 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
       << ", wrench " << args.wrench << ", lambda " << Fmt("%g", options.force_scale)
       << ", time limit " << Fmt("%g", time_limit) << " s"
       << (args.budget != 1.0 ? ", budget x" + Fmt("%g", args.budget) : std::string()) << ")\n";
-  PreprocessOptions pre_options;
-  pre_options.project_file = args.project;
-  pre_options.grasps = args.grasps;
-  auto pre = wrap::Preprocess(p, loaded.check, pre_options, ctx);
-  if (!pre) {
-    err << args.project << ": " << pre.error().message << "\n";
-    if (pre.error().code == ErrorCode::kTimeout) {
+  ProjectPlanOptions run;
+  run.preprocess.project_file = args.project;
+  run.preprocess.grasps = args.grasps;
+  run.pipeline.task = options;
+  run.pipeline.task_only = args.task_only;
+  run.pipeline.seed = seed;
+  run.pipeline.budget = args.budget;
+  run.pipeline.optimize_keyframes = !args.no_keyframe_opt;
+  run.pipeline.motion.dump_refused_dir = args.dump_refused;
+  run.on_preprocessed = [&](const Preprocessed& pre) {
+    for (const std::string& w : pre.warnings) err << args.project << ": warning: " << w << "\n";
+  };
+  auto made = PlanProject(p, loaded.check, run, ctx);
+  if (!made) {
+    const Error& e = made.error().error;
+    err << args.project << ": " << e.message << "\n";
+    if (made.error().stage == ProjectPlanError::Stage::kPreprocess &&
+        e.code == ErrorCode::kTimeout) {
       err << "no plan: the time limit ran out during preprocessing\n";
       return 1;
     }
-    return ExitCodeFor(pre.error().code);
+    return ExitCodeFor(e.code);
   }
-  for (const std::string& w : pre->warnings) err << args.project << ": warning: " << w << "\n";
-  PipelineOptions pipeline;
-  pipeline.task = options;
-  pipeline.task_only = args.task_only;
-  pipeline.seed = seed;
-  pipeline.budget = args.budget;
-  pipeline.optimize_keyframes = !args.no_keyframe_opt;
-  pipeline.motion.dump_refused_dir = args.dump_refused;
-  const auto t_plan = std::chrono::steady_clock::now();
-  auto plan = PlanAssembly(p, loaded.check, *pre, pipeline, ctx);
-  const double t_planning =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_plan).count();
-  if (!plan) {
-    err << args.project << ": " << plan.error().message << "\n";
-    return ExitCodeFor(plan.error().code);
-  }
-  plan->stats.seed = seed;
-  plan->contacts = ToPlanContacts(geometry.contacts);
-  const PlanStats& st = plan->stats;
+  const double t_planning = made->t_plan_s;
+  Plan& plan = made->plan;
+  plan.stats.seed = seed;
+  plan.contacts = ToPlanContacts(geometry.contacts);
+  const PlanStats& st = plan.stats;
   out << "Preprocessing (t_grasp) " << Fmt("%.2f", st.t_grasp_s) << " s\n";
   if (st.solved) {
     if (args.optimize) {
@@ -168,8 +165,8 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
         << " s (t_fwd " << Fmt("%.2f", st.t_fwd_s) << ", t_ik " << Fmt("%.2f", st.t_ik_s)
         << ", t_lp " << Fmt("%.2f", st.t_lp_s) << "; " << st.expansions << " nodes, "
         << st.validations << " edges validated, " << st.validation_failures << " failed)\n";
-    for (size_t i = 0; i < plan->actions.size(); ++i) {
-      out << "  " << (i + 1) << ". " << DescribeAction(*plan, plan->actions[i]) << "\n";
+    for (size_t i = 0; i < plan.actions.size(); ++i) {
+      out << "  " << (i + 1) << ". " << DescribeAction(plan, plan.actions[i]) << "\n";
     }
     if (st.motion) {
       out << "Motion: makespan " << Fmt("%.1f", st.makespan_s) << " s (one segment at a time "
@@ -186,7 +183,7 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   }
 
   if (!args.output.empty()) {
-    if (auto saved = SavePlan(*plan, args.output); !saved) {
+    if (auto saved = SavePlan(plan, args.output); !saved) {
       err << args.output << ": " << saved.error().message << "\n";
       return ExitCodeFor(saved.error().code);
     }
@@ -194,11 +191,11 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   }
   if (!st.solved) return 1;
   if (!args.validate) return 0;
-  if (const int code = ReportPlanValidation(loaded, *plan, args.project, out, err); code != 0) {
+  if (const int code = ReportPlanValidation(loaded, plan, args.project, out, err); code != 0) {
     return code;
   }
   if (!st.motion) return 0;
-  return ReportTrajectoryCheck(loaded, *plan, args.project, &*pre, out, err);
+  return ReportTrajectoryCheck(loaded, plan, args.project, &made->pre, out, err);
 }
 
 }  // namespace wrap::cli

@@ -1,3 +1,5 @@
+// The assembly tree of a project: part and step nodes, their inputs, the step order and the root,
+// with the diagnostics of a malformed tree.
 #include "model/assembly.h"
 
 #include <algorithm>
@@ -19,12 +21,8 @@ std::string StepPath(int s) { return "steps[" + std::to_string(s) + "]"; }
 
 std::string Quote(const std::string& s) { return "'" + s + "'"; }
 
-}  // namespace
-
-bool BuildAssemblyTree(const Project& project, const std::string& file, Diagnostics& diags,
-                       AssemblyTree& tree) {
-  const int errors_before = diags.error_count();
-  tree = AssemblyTree{};
+// One node per part (ids 0..parts-1), then one per step; returns the node id of each name.
+std::map<std::string, int> AddNodes(const Project& project, AssemblyTree& tree) {
   const int num_parts = static_cast<int>(project.parts.size());
   const int num_steps = static_cast<int>(project.steps.size());
   std::map<std::string, int> id_of;
@@ -43,8 +41,14 @@ bool BuildAssemblyTree(const Project& project, const std::string& file, Diagnost
     tree.nodes.push_back(n);
     id_of.emplace(n.name, num_parts + s);
   }
+  return id_of;
+}
 
-  // Edges: inputs must exist, be distinct, not be the step itself, and be used only once.
+// Edges: inputs must exist, be distinct, not be the step itself, and be used only once.
+void LinkInputs(const Project& project, const std::string& file,
+                const std::map<std::string, int>& id_of, Diagnostics& diags, AssemblyTree& tree) {
+  const int num_parts = static_cast<int>(project.parts.size());
+  const int num_steps = static_cast<int>(project.steps.size());
   for (int s = 0; s < num_steps; ++s) {
     const Step& step = project.steps[s];
     const int self = num_parts + s;
@@ -83,8 +87,58 @@ bool BuildAssemblyTree(const Project& project, const std::string& file, Diagnost
       ins.push_back(it->second);
     }
   }
+}
 
-  // Topological order (Kahn) over steps; steps left over are on a cycle.
+// The parts of step node `node`: the union of its inputs' parts, which must be disjoint, and
+// equal to the step's declared parts when it lists them.
+void CollectStepParts(const Project& project, const std::string& file,
+                      const std::map<std::string, int>& id_of, Diagnostics& diags,
+                      AssemblyTree& tree, AssemblyNode& node) {
+  std::set<int> seen;
+  for (int in : node.inputs) {
+    for (int p : tree.nodes[in].parts) {
+      if (!seen.insert(p).second) {
+        diags.Error(file, StepPath(node.step) + ".inputs",
+                    "part " + Quote(project.parts[p].name) + " is in both inputs of step " +
+                        Quote(node.name));
+      }
+    }
+  }
+  node.parts.assign(seen.begin(), seen.end());
+  const Step& step = project.steps[node.step];
+  if (step.parts.empty()) return;
+  std::set<int> declared;
+  for (const std::string& name : step.parts) {
+    auto it = id_of.find(name);
+    if (it == id_of.end() || tree.nodes[it->second].part < 0) {
+      diags.Error(file, StepPath(node.step) + ".parts", "unknown part " + Quote(name));
+      continue;
+    }
+    declared.insert(tree.nodes[it->second].part);
+  }
+  for (int p : declared) {
+    if (!seen.count(p)) {
+      diags.Error(file, StepPath(node.step) + ".parts",
+                  "the inputs do not partition the step's parts: part " +
+                      Quote(project.parts[p].name) + " is in no input");
+    }
+  }
+  for (int p : seen) {
+    if (!declared.count(p)) {
+      diags.Error(file, StepPath(node.step) + ".parts",
+                  "the inputs do not partition the step's parts: input part " +
+                      Quote(project.parts[p].name) + " is not listed");
+    }
+  }
+}
+
+// Topological order (Kahn) over steps into tree.step_order, collecting each step's parts on the
+// way; returns which nodes were ordered (steps left over are on a cycle).
+std::vector<bool> OrderSteps(const Project& project, const std::string& file,
+                             const std::map<std::string, int>& id_of, Diagnostics& diags,
+                             AssemblyTree& tree) {
+  const int num_parts = static_cast<int>(project.parts.size());
+  const int num_steps = static_cast<int>(project.steps.size());
   std::vector<int> pending(tree.nodes.size(), 0);
   for (int s = 0; s < num_steps; ++s) {
     for (int in : tree.nodes[num_parts + s].inputs) {
@@ -102,55 +156,15 @@ bool BuildAssemblyTree(const Project& project, const std::string& file, Diagnost
     done[id] = true;
     tree.step_order.push_back(id);
     AssemblyNode& node = tree.nodes[id];
-    // Parts of a step: the union of its inputs' parts, which must be disjoint.
-    std::set<int> seen;
-    for (int in : node.inputs) {
-      for (int p : tree.nodes[in].parts) {
-        if (!seen.insert(p).second) {
-          diags.Error(file, StepPath(node.step) + ".inputs",
-                      "part " + Quote(project.parts[p].name) + " is in both inputs of step " +
-                          Quote(node.name));
-        }
-      }
-    }
-    node.parts.assign(seen.begin(), seen.end());
-    const Step& step = project.steps[node.step];
-    if (!step.parts.empty()) {
-      std::set<int> declared;
-      for (const std::string& name : step.parts) {
-        auto it = id_of.find(name);
-        if (it == id_of.end() || tree.nodes[it->second].part < 0) {
-          diags.Error(file, StepPath(node.step) + ".parts", "unknown part " + Quote(name));
-          continue;
-        }
-        declared.insert(tree.nodes[it->second].part);
-      }
-      for (int p : declared) {
-        if (!seen.count(p)) {
-          diags.Error(file, StepPath(node.step) + ".parts",
-                      "the inputs do not partition the step's parts: part " +
-                          Quote(project.parts[p].name) + " is in no input");
-        }
-      }
-      for (int p : seen) {
-        if (!declared.count(p)) {
-          diags.Error(file, StepPath(node.step) + ".parts",
-                      "the inputs do not partition the step's parts: input part " +
-                          Quote(project.parts[p].name) + " is not listed");
-        }
-      }
-    }
+    CollectStepParts(project, file, id_of, diags, tree, node);
     if (node.consumer >= 0 && --pending[node.consumer] == 0) ready.push_back(node.consumer);
   }
-  std::string cycle;
-  for (int s = 0; s < num_steps; ++s) {
-    if (!done[num_parts + s]) cycle += (cycle.empty() ? "" : ", ") + Quote(project.steps[s].name);
-  }
-  if (!cycle.empty()) {
-    diags.Error(file, "steps", "the dependency graph has a cycle through steps " + cycle);
-  }
+  return done;
+}
 
-  // Roots: nodes nobody consumes.
+// The root: the one node nobody consumes (`cycle`: the steps on a cycle, already reported).
+void FindRoot(const std::string& file, const std::vector<bool>& done, const std::string& cycle,
+              Diagnostics& diags, AssemblyTree& tree) {
   std::vector<int> roots;
   for (size_t i = 0; i < tree.nodes.size(); ++i) {
     if (tree.nodes[i].consumer < 0 && (tree.nodes[i].step < 0 || done[i])) {
@@ -168,6 +182,27 @@ bool BuildAssemblyTree(const Project& project, const std::string& file, Diagnost
   } else if (roots.empty() && cycle.empty()) {
     diags.Error(file, "parts", "the project has no parts");
   }
+}
+
+}  // namespace
+
+bool BuildAssemblyTree(const Project& project, const std::string& file, Diagnostics& diags,
+                       AssemblyTree& tree) {
+  const int errors_before = diags.error_count();
+  tree = AssemblyTree{};
+  const int num_parts = static_cast<int>(project.parts.size());
+  const int num_steps = static_cast<int>(project.steps.size());
+  const std::map<std::string, int> id_of = AddNodes(project, tree);
+  LinkInputs(project, file, id_of, diags, tree);
+  const std::vector<bool> done = OrderSteps(project, file, id_of, diags, tree);
+  std::string cycle;
+  for (int s = 0; s < num_steps; ++s) {
+    if (!done[num_parts + s]) cycle += (cycle.empty() ? "" : ", ") + Quote(project.steps[s].name);
+  }
+  if (!cycle.empty()) {
+    diags.Error(file, "steps", "the dependency graph has a cycle through steps " + cycle);
+  }
+  FindRoot(file, done, cycle, diags, tree);
   return diags.error_count() == errors_before && tree.root >= 0;
 }
 

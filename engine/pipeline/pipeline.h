@@ -2,10 +2,13 @@
 // task planner (NextTaskPlan), each with its keyframes optimised jointly, queued with an effort
 // level; the motion planner takes the queued plan with the least effort (SelectFairly), and a plan
 // whose free path search spends its work budget is suspended and retried later with twice it,
-// while further task plans join the queue. The first plan with motion is returned.
+// while further task plans join the queue. The first plan with motion is returned. PlanProject
+// adds the preprocessing in front: the one call of the CLI's `wrap plan` and the GUI's planner job.
 #pragma once
 
 #include <cstdint>
+#include <expected>
+#include <functional>
 
 #include "core/result.h"
 #include "core/run_context.h"
@@ -43,5 +46,40 @@ struct PipelineOptions {
 [[nodiscard]] Result<Plan> PlanAssembly(const Project& project, const ProjectCheck& check,
                                         const Preprocessed& pre, const PipelineOptions& options,
                                         RunContext& ctx);
+
+/// Options of PlanProject: preprocessing's, the pipeline's, and a hook between the two.
+struct ProjectPlanOptions {
+  PreprocessOptions preprocess;  ///< Preprocess's.
+  PipelineOptions pipeline;      ///< PlanAssembly's.
+  /// Called with preprocessing's result before planning starts (e.g. to show its warnings while
+  /// the planner runs); may be empty.
+  std::function<void(const Preprocessed&)> on_preprocessed;
+};
+
+/// What PlanProject made.
+struct ProjectPlan {
+  Preprocessed pre;       ///< Preprocessing's result (a trajectory check can reuse it).
+  Plan plan;              ///< PlanAssembly's plan (solved or not: see its stats).
+  double t_plan_s = 0.0;  ///< Wall-clock time of PlanAssembly alone [s].
+};
+
+/// A failure of PlanProject, with the stage it came from.
+struct ProjectPlanError {
+  /// Where the run failed.
+  enum class Stage {
+    kPreprocess,  ///< Preprocess failed.
+    kPlan,        ///< PlanAssembly failed, or the run was cancelled before it started.
+  };
+  Stage stage = Stage::kPlan;  ///< Where.
+  Error error;                 ///< The stage's error.
+};
+
+/// Preprocesses and plans `project` (`check` from its validation) in one call: reports the
+/// progress stage "preprocess", runs Preprocess, stops with kCancelled if ctx is cancelled by
+/// then, calls on_preprocessed, reports the stage "task" and runs PlanAssembly, with ctx
+/// throughout. Fails like Preprocess (stage kPreprocess) and PlanAssembly (stage kPlan).
+[[nodiscard]] std::expected<ProjectPlan, ProjectPlanError> PlanProject(
+    const Project& project, const ProjectCheck& check, const ProjectPlanOptions& options,
+    RunContext& ctx);
 
 }  // namespace wrap

@@ -1,6 +1,7 @@
 // The collision world: rigid bodies made of shapes, their world poses, collision groups, an
 // allowed-pair filter, and collision and distance queries. The one FCL adapter: FCL is included
-// only by collision.cpp.
+// only by the world's sources (collision.cpp, collision_shapes.cpp, collision_narrowphase.cpp,
+// collision_query.cpp, distance_query.cpp) and their internal header detail/collision_impl.h.
 //
 // Queries run a sweep-and-prune broadphase over body bounding boxes, then box tests per shape
 // pair, then the narrowphase: exact closed forms for sphere/capsule pairs (most robot links), an

@@ -35,111 +35,109 @@ const char* kAxis[3] = {"x", "y", "z"};
 
 double Weight(int component) { return component < 3 ? 1.0 : kMomentWeight; }
 
-}  // namespace
-
-Result<std::vector<Shortfall>> FindShortfalls(const StepConfiguration& config,
-                                              const WrenchQuery& query, const Vec3& p_WO,
-                                              const double* w_ext, LpBackend& lp) {
-  const int nb = static_cast<int>(config.bodies.size());
-  const int rows = nb * 6;
-  std::vector<Column> cols;
-  std::vector<double> a;  // Column-major, grown column by column.
-  std::vector<double> lower, upper, cost;
-  std::vector<double> unit(rows);
-  auto add = [&](const Column& c, const double* values, double sign, double lo, double hi,
-                 double price) {
-    cols.push_back(c);
-    for (int i = 0; i < rows; ++i) a.push_back(sign * values[i]);
-    lower.push_back(lo);
-    upper.push_back(hi);
-    cost.push_back(price);
-  };
+// The minimum-violation LP, grown column by column: each Add* appends the columns of one kind of
+// support, in the order ReadShortfalls expects.
+class ViolationLp {
+ public:
+  ViolationLp(const StepConfiguration& config, const WrenchQuery& query, const Vec3& p_WO)
+      : config_(config),
+        query_(query),
+        p_WO_(p_WO),
+        rows_(static_cast<int>(config.bodies.size()) * 6),
+        unit_(rows_) {}
 
   // Grippers and connections: the component within its bounds plus a priced slack per finite
   // bound (a component fixed at 0, e.g. a vacuum cup's Fx while mating, is all slack).
-  auto add_limited = [&](SupportKind kind, int owner) {
+  void AddLimited(SupportKind kind, int owner) {
     for (int i = 0; i < 6; ++i) {
       const ColumnInfo info{kind, owner, i};
-      FillColumn(config, p_WO, info, unit.data());
+      FillColumn(config_, p_WO_, info, unit_.data());
       double lo, hi;
-      ComponentBounds(config, query.gate, info, lo, hi);
-      if (!(lo == 0.0 && hi == 0.0)) add({Role::kMain, kind, owner, i}, unit.data(), 1, lo, hi, 0);
-      if (std::isfinite(hi)) add({Role::kOver, kind, owner, i}, unit.data(), 1, 0, kInf, Weight(i));
-      if (std::isfinite(lo)) {
-        add({Role::kUnder, kind, owner, i}, unit.data(), -1, 0, kInf, Weight(i));
-      }
+      ComponentBounds(config_, query_.gate, info, lo, hi);
+      if (!(lo == 0.0 && hi == 0.0)) Add({Role::kMain, kind, owner, i}, 1, lo, hi, 0);
+      if (std::isfinite(hi)) Add({Role::kOver, kind, owner, i}, 1, 0, kInf, Weight(i));
+      if (std::isfinite(lo)) Add({Role::kUnder, kind, owner, i}, -1, 0, kInf, Weight(i));
     }
-  };
-  if (GrippersActive(query.gate)) {
-    for (int g = 0; g < static_cast<int>(config.grippers.size()); ++g) {
-      add_limited(SupportKind::kGripper, g);
-    }
-  }
-  for (int c = 0; c < static_cast<int>(config.connections.size()); ++c) {
-    add_limited(SupportKind::kConnection, c);
   }
 
-  // Tables: the pyramid generators, then per polygon vertex the friction and lift slacks.
-  if (TablesActive(query.gate)) {
-    for (int t = 0; t < static_cast<int>(config.tables.size()); ++t) {
-      const WrenchTableSupport& table = config.tables[t];
-      const int edges = PyramidEdges(table);
-      const int generators = static_cast<int>(table.p_WV.size()) * edges;
-      for (int e = 0; e < generators; ++e) {
-        FillColumn(config, p_WO, {SupportKind::kTable, t, e}, unit.data());
-        add({Role::kTable, SupportKind::kTable, t, e}, unit.data(), 1, 0, kInf, 0);
-      }
-      Vec3 n, t1, t2;
-      TableTangents(table, n, t1, t2);
-      const Vec3 dirs[5] = {t1, -t1, t2, -t2, -n};
-      for (const Vec3& v : table.p_WV) {
-        for (int d = 0; d < 5; ++d) {
-          std::fill(unit.begin(), unit.end(), 0.0);
-          const Vec3 m = (v - p_WO).cross(dirs[d]);
-          for (int i = 0; i < 3; ++i) {
-            unit[table.body * 6 + i] = dirs[d][i];
-            unit[table.body * 6 + 3 + i] = m[i];
-          }
-          const Role role = d < 4 ? Role::kFriction : Role::kLift;
-          add({role, SupportKind::kTable, t, d}, unit.data(), 1, 0, kInf, 1.0);
+  // Table t: the pyramid generators, then per polygon vertex the friction and lift slacks.
+  void AddTable(int t) {
+    const WrenchTableSupport& table = config_.tables[t];
+    const int edges = PyramidEdges(table);
+    const int generators = static_cast<int>(table.p_WV.size()) * edges;
+    for (int e = 0; e < generators; ++e) {
+      FillColumn(config_, p_WO_, {SupportKind::kTable, t, e}, unit_.data());
+      Add({Role::kTable, SupportKind::kTable, t, e}, 1, 0, kInf, 0);
+    }
+    Vec3 n, t1, t2;
+    TableTangents(table, n, t1, t2);
+    const Vec3 dirs[5] = {t1, -t1, t2, -t2, -n};
+    for (const Vec3& v : table.p_WV) {
+      for (int d = 0; d < 5; ++d) {
+        std::fill(unit_.begin(), unit_.end(), 0.0);
+        const Vec3 m = (v - p_WO_).cross(dirs[d]);
+        for (int i = 0; i < 3; ++i) {
+          unit_[table.body * 6 + i] = dirs[d][i];
+          unit_[table.body * 6 + 3 + i] = m[i];
         }
+        const Role role = d < 4 ? Role::kFriction : Role::kLift;
+        Add({role, SupportKind::kTable, t, d}, 1, 0, kInf, 1.0);
       }
     }
   }
 
   // Residuals: a free wrench on each body, expensive.
-  for (int r = 0; r < rows; ++r) {
-    std::fill(unit.begin(), unit.end(), 0.0);
-    unit[r] = 1.0;
-    const double price = kResidualWeight * Weight(r % 6);
-    add({Role::kResidual, SupportKind::kGripper, r / 6, r % 6}, unit.data(), 1, 0, kInf, price);
-    add({Role::kResidual, SupportKind::kGripper, r / 6, r % 6}, unit.data(), -1, 0, kInf, price);
+  void AddResiduals() {
+    for (int r = 0; r < rows_; ++r) {
+      std::fill(unit_.begin(), unit_.end(), 0.0);
+      unit_[r] = 1.0;
+      const double price = kResidualWeight * Weight(r % 6);
+      Add({Role::kResidual, SupportKind::kGripper, r / 6, r % 6}, 1, 0, kInf, price);
+      Add({Role::kResidual, SupportKind::kGripper, r / 6, r % 6}, -1, 0, kInf, price);
+    }
   }
 
-  LpProblem problem;
-  problem.rows = rows;
-  problem.cols = static_cast<int>(cols.size());
-  problem.a = std::move(a);
-  problem.lower = std::move(lower);
-  problem.upper = std::move(upper);
-  problem.cost = std::move(cost);
-  problem.rhs.resize(rows);
-  double scale = 1.0;
-  for (int i = 0; i < rows; ++i) {
-    problem.rhs[i] = -w_ext[i];
-    scale = std::max(scale, std::abs(w_ext[i]));
-  }
-  LpSolution solution;
-  const LpStatus status = lp.Solve(problem, solution);
-  if (status != LpStatus::kOptimal) {
-    return Fail(ErrorCode::kInternal, "wrench: minimum-violation LP (" + std::string(lp.name()) +
-                                          ") returned " + std::string(ToString(status)));
+  const std::vector<Column>& columns() const { return cols_; }
+
+  // The problem with right-hand side -w_ext (moves the columns out).
+  LpProblem TakeProblem(const double* w_ext) {
+    LpProblem problem;
+    problem.rows = rows_;
+    problem.cols = static_cast<int>(cols_.size());
+    problem.a = std::move(a_);
+    problem.lower = std::move(lower_);
+    problem.upper = std::move(upper_);
+    problem.cost = std::move(cost_);
+    problem.rhs.resize(rows_);
+    for (int i = 0; i < rows_; ++i) problem.rhs[i] = -w_ext[i];
+    return problem;
   }
 
-  // Read the slacks back.
-  const double eps = 1e-6 * scale;
-  std::vector<Shortfall> out;
-  std::vector<double> weight;
+ private:
+  // Appends `sign` times the scratch column `unit_`.
+  void Add(const Column& c, double sign, double lo, double hi, double price) {
+    cols_.push_back(c);
+    for (int i = 0; i < rows_; ++i) a_.push_back(sign * unit_[i]);
+    lower_.push_back(lo);
+    upper_.push_back(hi);
+    cost_.push_back(price);
+  }
+
+  const StepConfiguration& config_;
+  const WrenchQuery& query_;
+  const Vec3& p_WO_;
+  int rows_ = 0;
+  std::vector<Column> cols_;
+  std::vector<double> a_;  // Column-major.
+  std::vector<double> lower_, upper_, cost_;
+  std::vector<double> unit_;  // Scratch: the column being added.
+};
+
+// The shortfalls the optimal slacks `x` of `cols` show (those above `eps`), each with the price
+// it costs, in column order.
+void ReadShortfalls(const StepConfiguration& config, const WrenchQuery& query,
+                    const std::vector<Column>& cols, const std::vector<double>& x, double eps,
+                    std::vector<Shortfall>& out, std::vector<double>& weight) {
   auto push = [&](const Shortfall& s, double w) {
     out.push_back(s);
     weight.push_back(w);
@@ -155,10 +153,9 @@ Result<std::vector<Shortfall>> FindShortfalls(const StepConfiguration& config,
              (cols[k].role == Role::kMain || cols[k].role == Role::kOver ||
               cols[k].role == Role::kUnder);
            ++k) {
-        const double x = solution.x[k];
-        if (cols[k].role == Role::kMain) main = x;
-        if (cols[k].role == Role::kOver) over = x;
-        if (cols[k].role == Role::kUnder) under = x;
+        if (cols[k].role == Role::kMain) main = x[k];
+        if (cols[k].role == Role::kOver) over = x[k];
+        if (cols[k].role == Role::kUnder) under = x[k];
       }
       double lo, hi;
       ComponentBounds(config, query.gate, {c.kind, c.owner, c.component}, lo, hi);
@@ -177,10 +174,10 @@ Result<std::vector<Shortfall>> FindShortfalls(const StepConfiguration& config,
       while (k < cols.size() && cols[k].owner == c.owner &&
              (cols[k].role == Role::kFriction || cols[k].role == Role::kLift)) {
         // Five columns per vertex: +t1, -t1, +t2, -t2, -n.
-        const double f1 = solution.x[k] - solution.x[k + 1];
-        const double f2 = solution.x[k + 2] - solution.x[k + 3];
+        const double f1 = x[k] - x[k + 1];
+        const double f2 = x[k + 2] - x[k + 3];
         friction += std::hypot(f1, f2);
-        lift += solution.x[k + 4];
+        lift += x[k + 4];
         k += 5;
       }
       if (friction > eps) push({ShortfallKind::kTableFriction, c.owner, -1, friction, 0}, friction);
@@ -189,7 +186,7 @@ Result<std::vector<Shortfall>> FindShortfalls(const StepConfiguration& config,
       continue;
     }
     if (c.role == Role::kResidual) {
-      const double r = solution.x[j] - solution.x[j + 1];
+      const double r = x[j] - x[j + 1];
       if (std::abs(r) > eps) {
         push({ShortfallKind::kUnbalanced, c.owner, c.component, r, 0},
              std::abs(r) * kResidualWeight * Weight(c.component));
@@ -199,8 +196,11 @@ Result<std::vector<Shortfall>> FindShortfalls(const StepConfiguration& config,
     }
     ++j;
   }
+}
 
-  // Order: unbalanced load first, then forces (and the table), then moments, each by size.
+// Order: unbalanced load first, then forces (and the table), then moments, each by size.
+std::vector<Shortfall> Sorted(const std::vector<Shortfall>& out,
+                              const std::vector<double>& weight) {
   auto tier = [](const Shortfall& f) {
     if (f.kind == ShortfallKind::kUnbalanced) return 0;
     return f.component >= 3 ? 2 : 1;
@@ -215,6 +215,42 @@ Result<std::vector<Shortfall>> FindShortfalls(const StepConfiguration& config,
   sorted.reserve(out.size());
   for (int i : order) sorted.push_back(out[i]);
   return sorted;
+}
+
+}  // namespace
+
+Result<std::vector<Shortfall>> FindShortfalls(const StepConfiguration& config,
+                                              const WrenchQuery& query, const Vec3& p_WO,
+                                              const double* w_ext, LpBackend& lp) {
+  ViolationLp builder(config, query, p_WO);
+  if (GrippersActive(query.gate)) {
+    for (int g = 0; g < static_cast<int>(config.grippers.size()); ++g) {
+      builder.AddLimited(SupportKind::kGripper, g);
+    }
+  }
+  for (int c = 0; c < static_cast<int>(config.connections.size()); ++c) {
+    builder.AddLimited(SupportKind::kConnection, c);
+  }
+  if (TablesActive(query.gate)) {
+    for (int t = 0; t < static_cast<int>(config.tables.size()); ++t) builder.AddTable(t);
+  }
+  builder.AddResiduals();
+
+  const LpProblem problem = builder.TakeProblem(w_ext);
+  double scale = 1.0;
+  for (int i = 0; i < problem.rows; ++i) scale = std::max(scale, std::abs(w_ext[i]));
+  LpSolution solution;
+  const LpStatus status = lp.Solve(problem, solution);
+  if (status != LpStatus::kOptimal) {
+    return Fail(ErrorCode::kInternal, "wrench: minimum-violation LP (" + std::string(lp.name()) +
+                                          ") returned " + std::string(ToString(status)));
+  }
+
+  // Read the slacks back.
+  std::vector<Shortfall> out;
+  std::vector<double> weight;
+  ReadShortfalls(config, query, builder.columns(), solution.x, 1e-6 * scale, out, weight);
+  return Sorted(out, weight);
 }
 
 namespace {

@@ -25,25 +25,29 @@
 // force while mating, paper table of limits). Before the parts touch, the grippers already hold
 // their weight, as in transport; the paper's assembly box bounds what the insertion adds, since
 // it is the insertion's transverse load that deflects a cup. Such a step is checked in two
-// stages ("held, then mated"): first the gravity-only LP with transport limits gives the holding
-// wrenches h (the minimised largest utilisation, h = x / s); then, per vertex of the mating set
-// without gravity, the load-factor LP above over increments m with
-//     vacuum components:   max(assembly lower, transport lower - h) <= m <= min(assembly upper,
-//                          transport upper - h)
-//     other grippers and connections: lower - h <= m <= upper - h
-//     table generators:    m >= -h (the total coefficient stays >= 0),
-// so every total h + m lies within its limits. s then scales the mating load alone; a vertex's
-// utilisation is the largest |h + m / s| / limit over grippers and connections when s >= 1,
-// else 1 / s. With h fixed the check is conservative (a different holding split could leave
-// more room); configurations whose grippers have one box for both modes take the single LP.
+// stages ("held, then mated"). Stage 1: the gravity-only load-factor LP with transport limits;
+// when the weight cannot be held (s < 1) the step fails there. Stage 2, per vertex w of the
+// mating set without gravity: one LP over the holding wrenches h and the totals t together,
+//
+//     maximise s   subject to   A h = -w_grav,   A (t - h) + s w = 0,
+//                               h and t within the total bounds (grippers' transport boxes,
+//                               connections' limits, table coefficients >= 0),
+//                               t - h within the assembly box for each component of a
+//                               gripper whose assembly box differs (vacuum),
+//
+// so the holding split is chosen with the mating load in view (no h is fixed beforehand). s
+// scales the mating load alone; a vertex's utilisation is the larger of stage 1's and 1 / s, and
+// the loads it reports are h + (t - h) / s. Configurations whose grippers have one box for both
+// modes take the single LP. When a vertex fails, the explanation fixes the worst vertex's h and
+// names what the mating load needs beyond what that h leaves.
 //
 // Robust satisfaction: feasible iff every vertex has s >= 1 - tolerance. Each support reports the
 // largest utilisation over the vertices; a table reports the friction its resultant force uses,
 // |F_t| / (mu F_n). When infeasible, explain.cpp names the binding limits at the worst vertex.
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <limits>
+#include <numbers>
 #include <unordered_map>
 
 #include "wrench/detail/canonical_key.h"
@@ -99,14 +103,14 @@ struct WrenchChecker::Impl {
     ++solves;
     pivots += static_cast<std::uint64_t>(solution.iterations);
     return status == LpStatus::kOptimal || status == LpStatus::kUnbounded ? status
-                                                                         : SolveReference(full);
+                                                                          : SolveReference(full);
   }
   LpStatus SolveFull(const LpProblem& full) {
     const LpStatus status = lp->Solve(full, solution);
     ++solves;
     pivots += static_cast<std::uint64_t>(solution.iterations);
     return status == LpStatus::kOptimal || status == LpStatus::kUnbounded ? status
-                                                                         : SolveReference(full);
+                                                                          : SolveReference(full);
   }
   LpStatus SolveReference(const LpProblem& full) {
     if (options.backend == WrenchLpBackend::kClp) return solution.status;
@@ -122,12 +126,20 @@ struct WrenchChecker::Impl {
   // The internal error of an LP that ended with `status` instead of an answer.
   std::unexpected<Error> LpFailed(LpStatus status, const std::string& which) const {
     return Fail(ErrorCode::kInternal, "wrench: LP backend '" + std::string(lp->name()) +
-                                          "' returned " + std::string(ToString(status)) +
-                                          " on " + which);
+                                          "' returned " + std::string(ToString(status)) + " on " +
+                                          which);
   }
   // The "held, then mated" assembly check (see the top of this file); `out` has its supports.
   Result<WrenchCheck> ComputeHeldThenMated(const StepConfiguration& config,
                                            const WrenchQuery& query, WrenchCheck out);
+  // Stage 2 of ComputeHeldThenMated: the joint LP over holding wrenches h and totals t (see the
+  // top of this file) into zero_problem, with `w_grav` on the gravity rows; returns the column of
+  // s, whose mating rows each vertex fills.
+  int BuildJointProblem(const StepConfiguration& config, const double* w_grav);
+  // Stage 2's loop over `vertices` (the mating set without gravity): the vertex results into
+  // `out`, its utilisation at least `hold_utilisation`; returns the worst vertex's h.
+  Result<std::vector<double>> SolveMatingVertices(const StepConfiguration& config, int s_col,
+                                                  double hold_utilisation, WrenchCheck& out);
   // Columns of every support of an assembly check (grippers with their transport components);
   // fills columns, support_of, edge, lower, upper (the total bounds) and problem's columns.
   void BuildColumns(const StepConfiguration& config, WrenchGate gate, const Vec3& p_WO,
@@ -271,8 +283,8 @@ Result<WrenchCheck> WrenchChecker::Impl::Finish(const StepConfiguration& explain
   if (set.count == 1) {
     reason += " (" + out.worst_vertex_label + "): ";
   } else {
-    reason += ": vertex " + std::to_string(out.worst_vertex + 1) + "/" +
-              std::to_string(set.count) + " (" + out.worst_vertex_label + "): ";
+    reason += ": vertex " + std::to_string(out.worst_vertex + 1) + "/" + std::to_string(set.count) +
+              " (" + out.worst_vertex_label + "): ";
   }
   if (out.shortfalls.empty()) {
     reason += std::isinf(out.utilisation)
@@ -280,8 +292,8 @@ Result<WrenchCheck> WrenchChecker::Impl::Finish(const StepConfiguration& explain
                   : "the supports would need " + detail::FormatNumber(100.0 * out.utilisation) +
                         "% of their limits";
   } else {
-    reason += detail::DescribeShortfalls(explain_config, query, out.shortfalls,
-                                         kMaxShortfallsInReason);
+    reason +=
+        detail::DescribeShortfalls(explain_config, query, out.shortfalls, kMaxShortfallsInReason);
   }
   if (out.failing_vertex_count > 1) {
     reason += " (" + std::to_string(out.failing_vertex_count - 1) + " more of the " +
@@ -376,47 +388,44 @@ Result<void> WrenchChecker::Impl::SolveAtZeroUtilisation(int n) {
   return {};
 }
 
-Result<WrenchCheck> WrenchChecker::Impl::ComputeHeldThenMated(const StepConfiguration& config,
-                                                              const WrenchQuery& query,
-                                                              WrenchCheck out) {
-  const Vec3 p_WO = detail::ReferencePoint(config);
-  const int nb6 = static_cast<int>(config.bodies.size()) * 6;
-  BuildColumns(config, WrenchGate::kAssembly, p_WO, true);  // Total bounds: transport boxes.
-  const int n = static_cast<int>(columns.size());
-  const double s_feasible = 1.0 - options.tolerance;
+namespace {
 
-  // Stage 1: the weight held before the parts touch (transport limits, tables as they are).
-  WrenchQuery hold_query = query;
-  hold_query.gate = WrenchGate::kRelease;
-  hold_query.mode = MatingWrenchMode::kGravityOnly;
-  detail::VertexSet hold_set;
-  detail::BuildVertices(config, hold_query, p_WO, hold_set);
-  const double* w_grav = hold_set.vertex(0);
-  double hold_utilisation = 0.0;
-  {
-    std::copy(w_grav, w_grav + nb6, problem.column(n));
-    lp->LoadBase(problem, n);
-    const LpStatus status = SolveVarying(problem, w_grav);
-    if (status == LpStatus::kOptimal) {
-      const double s = solution.x[n] > kTinyLoadFactor ? solution.x[n] : 0.0;
-      hold_utilisation = s > 0.0 ? 1.0 / s : kInf;
-      if (s < s_feasible) {
-        out.vertex_count = 1;
-        out.failing_vertex_count = 1;
-        out.worst_vertex = 0;
-        out.utilisation = hold_utilisation;
-        if (s > 0.0) Accumulate(config, solution.x, 1.0 / s, 0, out);
-        return Finish(config, hold_query, p_WO, hold_set, std::move(out),
-                      "assembly, holding the parts before they touch");
-      }
-    } else if (status != LpStatus::kUnbounded) {
-      return LpFailed(status, "the holding LP");
+// The configuration whose assembly check names what the mating load needs beyond what the
+// holding wrenches `hold` (per column of `columns`) leave: `mating_only` (no gravity) with totals
+// within limits and mode-dependent grippers within their assembly box.
+StepConfiguration LeftForMating(const StepConfiguration& config,
+                                const StepConfiguration& mating_only,
+                                const std::vector<detail::ColumnInfo>& columns,
+                                const std::vector<double>& lower, const std::vector<double>& upper,
+                                const std::vector<double>& hold) {
+  StepConfiguration left = mating_only;
+  for (WrenchGripper& g : left.grippers) g.assembly_limits = WrenchBounds{};
+  for (WrenchConnection& c : left.connections) c.limits = WrenchBounds{};
+  const int n = static_cast<int>(columns.size());
+  for (int j = 0; j < n; ++j) {
+    const detail::ColumnInfo& c = columns[j];
+    if (c.kind == SupportKind::kTable) continue;
+    double lo = std::min(0.0, lower[j] - hold[j]);
+    double hi = std::max(0.0, upper[j] - hold[j]);
+    if (c.kind == SupportKind::kGripper) {
+      const WrenchBounds& box = config.grippers[c.owner].assembly_limits;
+      lo = std::min(0.0, std::max(lo, box.lower[c.component]));
+      hi = std::max(0.0, std::min(hi, box.upper[c.component]));
+      left.grippers[c.owner].assembly_limits.lower[c.component] = lo;
+      left.grippers[c.owner].assembly_limits.upper[c.component] = hi;
+    } else {
+      left.connections[c.owner].limits.lower[c.component] = lo;
+      left.connections[c.owner].limits.upper[c.component] = hi;
     }
   }
+  return left;
+}
 
-  // Stage 2, per vertex of the mating set without gravity: holding wrenches h balance gravity,
-  // totals t balance gravity plus s times the mating load, both within the total bounds, and a
-  // mode-dependent gripper's increment d = t - h within its assembly box.
+}  // namespace
+
+int WrenchChecker::Impl::BuildJointProblem(const StepConfiguration& config, const double* w_grav) {
+  const int nb6 = static_cast<int>(config.bodies.size()) * 6;
+  const int n = static_cast<int>(columns.size());
   std::vector<int> coupled;  // Columns of grippers whose assembly box differs.
   for (int j = 0; j < n; ++j) {
     const detail::ColumnInfo& c = columns[j];
@@ -455,11 +464,16 @@ Result<WrenchCheck> WrenchChecker::Impl::ComputeHeldThenMated(const StepConfigur
   joint.cost[s_col] = -1.0;  // Maximise s.
   joint.lower[s_col] = 0.0;
   joint.upper[s_col] = kInf;
+  return s_col;
+}
 
-  StepConfiguration mating_only = config;
-  mating_only.gravity_W = Vec3::Zero();
-  detail::BuildVertices(mating_only, query, p_WO, vertices);
-  out.vertex_count = vertices.count;
+Result<std::vector<double>> WrenchChecker::Impl::SolveMatingVertices(
+    const StepConfiguration& config, int s_col, double hold_utilisation, WrenchCheck& out) {
+  const int nb6 = static_cast<int>(config.bodies.size()) * 6;
+  const int n = static_cast<int>(columns.size());
+  const int nv = s_col - 2 * n;
+  const double s_feasible = 1.0 - options.tolerance;
+  LpProblem& joint = zero_problem;
   lp->LoadBase(joint, s_col);
   std::vector<double> total(n), hold(n);
   std::vector<double> worst_hold;
@@ -510,31 +524,65 @@ Result<WrenchCheck> WrenchChecker::Impl::ComputeHeldThenMated(const StepConfigur
     }
   }
   out.utilisation = worst < 0.0 ? hold_utilisation : worst;
+  return worst_hold;
+}
+
+Result<WrenchCheck> WrenchChecker::Impl::ComputeHeldThenMated(const StepConfiguration& config,
+                                                              const WrenchQuery& query,
+                                                              WrenchCheck out) {
+  const Vec3 p_WO = detail::ReferencePoint(config);
+  const int nb6 = static_cast<int>(config.bodies.size()) * 6;
+  BuildColumns(config, WrenchGate::kAssembly, p_WO, true);  // Total bounds: transport boxes.
+  const int n = static_cast<int>(columns.size());
+  const double s_feasible = 1.0 - options.tolerance;
+
+  // Stage 1: the weight held before the parts touch (transport limits, tables as they are).
+  WrenchQuery hold_query = query;
+  hold_query.gate = WrenchGate::kRelease;
+  hold_query.mode = MatingWrenchMode::kGravityOnly;
+  detail::VertexSet hold_set;
+  detail::BuildVertices(config, hold_query, p_WO, hold_set);
+  const double* w_grav = hold_set.vertex(0);
+  double hold_utilisation = 0.0;
+  {
+    std::copy(w_grav, w_grav + nb6, problem.column(n));
+    lp->LoadBase(problem, n);
+    const LpStatus status = SolveVarying(problem, w_grav);
+    if (status == LpStatus::kOptimal) {
+      const double s = solution.x[n] > kTinyLoadFactor ? solution.x[n] : 0.0;
+      hold_utilisation = s > 0.0 ? 1.0 / s : kInf;
+      if (s < s_feasible) {
+        out.vertex_count = 1;
+        out.failing_vertex_count = 1;
+        out.worst_vertex = 0;
+        out.utilisation = hold_utilisation;
+        if (s > 0.0) Accumulate(config, solution.x, 1.0 / s, 0, out);
+        return Finish(config, hold_query, p_WO, hold_set, std::move(out),
+                      "assembly, holding the parts before they touch");
+      }
+    } else if (status != LpStatus::kUnbounded) {
+      return LpFailed(status, "the holding LP");
+    }
+  }
+
+  // Stage 2, per vertex of the mating set without gravity: holding wrenches h balance gravity,
+  // totals t balance gravity plus s times the mating load, both within the total bounds, and a
+  // mode-dependent gripper's increment d = t - h within its assembly box.
+  const int s_col = BuildJointProblem(config, w_grav);
+  StepConfiguration mating_only = config;
+  mating_only.gravity_W = Vec3::Zero();
+  detail::BuildVertices(mating_only, query, p_WO, vertices);
+  out.vertex_count = vertices.count;
+  Result<std::vector<double>> worst_hold =
+      SolveMatingVertices(config, s_col, hold_utilisation, out);
+  if (!worst_hold) return std::unexpected(worst_hold.error());
   if (out.failing_vertex_count == 0) {
     return Finish(config, query, p_WO, vertices, std::move(out), "assembly");
   }
   // The explanation: what the mating load needs beyond what the holding wrenches of the worst
-  // vertex leave (totals within limits, mode-dependent grippers within their assembly box).
-  StepConfiguration left = mating_only;
-  for (WrenchGripper& g : left.grippers) g.assembly_limits = WrenchBounds{};
-  for (WrenchConnection& c : left.connections) c.limits = WrenchBounds{};
-  for (int j = 0; j < n; ++j) {
-    const detail::ColumnInfo& c = columns[j];
-    if (c.kind == SupportKind::kTable) continue;
-    double lo = std::min(0.0, lower[j] - worst_hold[j]);
-    double hi = std::max(0.0, upper[j] - worst_hold[j]);
-    if (c.kind == SupportKind::kGripper) {
-      const WrenchBounds& box = config.grippers[c.owner].assembly_limits;
-      lo = std::min(0.0, std::max(lo, box.lower[c.component]));
-      hi = std::max(0.0, std::min(hi, box.upper[c.component]));
-      left.grippers[c.owner].assembly_limits.lower[c.component] = lo;
-      left.grippers[c.owner].assembly_limits.upper[c.component] = hi;
-    } else {
-      left.connections[c.owner].limits.lower[c.component] = lo;
-      left.connections[c.owner].limits.upper[c.component] = hi;
-    }
-  }
-  return Finish(left, query, p_WO, vertices, std::move(out), "assembly");
+  // vertex leave.
+  return Finish(LeftForMating(config, mating_only, columns, lower, upper, *worst_hold), query, p_WO,
+                vertices, std::move(out), "assembly");
 }
 
 WrenchChecker::WrenchChecker(const WrenchOptions& options) : impl_(std::make_unique<Impl>()) {

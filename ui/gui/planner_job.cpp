@@ -8,9 +8,9 @@
 
 #include "core/run_context.h"
 #include "grasp/preprocess.h"
+#include "mating/project_check.h"
 #include "model/validate.h"
 #include "pipeline/pipeline.h"
-#include "mating/project_check.h"
 #include "task/planner.h"
 
 namespace wrap::gui {
@@ -182,40 +182,38 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
     task.wrench_mode = request.wrench == "gravity" ? MatingWrenchMode::kGravityOnly
                        : request.wrench == "none"  ? MatingWrenchMode::kNone
                                                    : MatingWrenchMode::kFull;
-    stage("preprocess", "placements, table slots and grasp sets");
-    PreprocessOptions pre_options;
-    pre_options.project_file = file;
-    pre_options.grasps = request.grasps;
-    auto pre = Preprocess(project, check, pre_options, ctx);
+    ProjectPlanOptions run;
+    run.preprocess.project_file = file;
+    run.preprocess.grasps = request.grasps;
+    run.pipeline.task = task;
+    run.pipeline.task_only = request.task_only;
+    run.pipeline.seed = request.seed;
+    run.pipeline.budget = request.budget;
+    run.on_preprocessed = [this](const Preprocessed& pre) {
+      for (const std::string& w : pre.warnings) {
+        Log("warning: " + w);
+        std::lock_guard lock(mutex_);
+        progress_.warnings.push_back(w);
+      }
+    };
+    // Reports the stages "preprocess" and "task" as it goes.
+    auto made = PlanProject(project, check, run, ctx);
     if (stopped()) return;
-    if (!pre) {
-      Finish(JobState::kFailed, "preprocessing: " + pre.error().message, nullptr);
+    if (!made) {
+      const Error& e = made.error().error;
+      if (made.error().stage == ProjectPlanError::Stage::kPreprocess) {
+        Finish(JobState::kFailed, "preprocessing: " + e.message, nullptr);
+      } else {
+        Finish(e.code == ErrorCode::kCancelled ? JobState::kCancelled : JobState::kFailed,
+               e.message, nullptr);
+      }
       return;
     }
-    for (const std::string& w : pre->warnings) {
-      Log("warning: " + w);
-      std::lock_guard lock(mutex_);
-      progress_.warnings.push_back(w);
-    }
-
-    stage("task", "searching for a task plan (" + request.planner + ")");
-    PipelineOptions pipeline;
-    pipeline.task = task;
-    pipeline.task_only = request.task_only;
-    pipeline.seed = request.seed;
-    pipeline.budget = request.budget;
-    auto plan = PlanAssembly(project, check, *pre, pipeline, ctx);
-    if (stopped()) return;
-    if (!plan) {
-      const JobState state =
-          plan.error().code == ErrorCode::kCancelled ? JobState::kCancelled : JobState::kFailed;
-      Finish(state, plan.error().message, nullptr);
-      return;
-    }
-    plan->stats.seed = request.seed;
+    Plan& plan = made->plan;
+    plan.stats.seed = request.seed;
     // The plan moves into the shared one: its stats are read from there (reading them through
     // the moved-from plan gave an empty failure, "no plan found", where the CLI said why).
-    auto shared = std::make_shared<const Plan>(std::move(*plan));
+    auto shared = std::make_shared<const Plan>(std::move(plan));
     const PlanStats& st = shared->stats;
     Log("cost " + std::to_string(st.cost) + ", " + std::to_string(shared->actions.size()) +
         " actions" + (st.motion ? ", makespan " + std::to_string(st.makespan_s) + " s" : ""));
