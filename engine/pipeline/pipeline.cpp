@@ -335,7 +335,9 @@ std::expected<ProjectPlan, ProjectPlanError> PlanProject(const Project& project,
   if (!pre) return std::unexpected(ProjectPlanError{Stage::kPreprocess, pre.error()});
   if (options.on_preprocessed) options.on_preprocessed(*pre);
 
-  ctx.Progress("task", -1.0, "searching for a task plan (" + options.pipeline.task.planner + ")");
+  ctx.Progress(
+      "task", -1.0,
+      "searching for a task plan (" + std::string(ToString(options.pipeline.task.planner)) + ")");
   const auto t_plan = std::chrono::steady_clock::now();
   auto plan = PlanAssembly(project, check, *pre, options.pipeline, ctx);
   const double t_plan_s = Since(t_plan);
