@@ -10,6 +10,7 @@
 
 #include "robot/kinematics.h"
 #include "task/failure.h"
+#include "task/skill_geometry.h"
 
 namespace wrap {
 
@@ -26,9 +27,10 @@ struct MotionOptions {
   /// Work budget of the search over a carried object's poses at effort 1 (it runs from effort
   /// 1 on): edges tried, each tracked by the holders' IK and checked for collisions.
   int carry_edges = 500;
-  int max_effort = 3;               ///< Effort levels 0..max_effort; the budgets double per level.
-  double approach_m = 0.04;         ///< Straight approach to (and retreat from) a grasp [m].
-  double lift_m = 0.02;             ///< Straight lift off (and descent onto) the table [m].
+  int max_effort = 3;  ///< Effort levels 0..max_effort; the budgets double per level.
+  /// Skill lengths (approach_m, lift_m) and the robots' clearance at keyframes: the task
+  /// planner's (PlanAssembly sets them from TaskPlannerOptions::skills).
+  SkillGeometry skills;
   double cartesian_step_m = 0.004;  ///< Spacing of IK samples along a straight move [m].
   double skill_speed_mps = 0.05;    ///< TCP speed of approach, retreat, lift, descent [m/s].
   double insert_speed_mps = 0.02;   ///< TCP speed of an insertion [m/s].

@@ -289,7 +289,7 @@ bool SegmentBuilder::FinalSkills(int i, ActionWork& w) {
               std::move(w.hover_descent), w.hover_length, opt_.skill_speed_mps);
   }
   if (a.type == ActionType::kPlace) {
-    PushSkill(SegmentKind::kDescend, i, true, a.robots[0], w.grasped, w.descend, opt_.lift_m,
+    PushSkill(SegmentKind::kDescend, i, true, a.robots[0], w.grasped, w.descend, opt_.skills.lift_m,
               opt_.skill_speed_mps);
   }
   if (w.assemble && a.approach && !Insert(i)) return false;
@@ -385,7 +385,7 @@ bool SegmentBuilder::KeyframeAccepts(int robot, const JointVector& q, const Keyf
   }
   DistanceRequest request;
   request.upper_bound_m = 0.02;
-  return scene_.cell().MinRobotClearance(request).distance >= kMinClearance;
+  return scene_.cell().MinRobotClearance(request).distance >= opt_.skills.robot_clearance_m;
 }
 
 bool SegmentBuilder::StageAccepts(int robot, int action, bool from_approach,

@@ -38,8 +38,6 @@ constexpr int kRefine = 4;
 // Joint perturbation and sample count of the tight-pocket test [rad].
 constexpr double kTightRad = 0.03;
 constexpr int kTightSamples = 16;
-// Least distance between two robots at a keyframe, as the task planner keeps it [m].
-constexpr double kMinClearance = 0.005;
 
 inline bool Same(const JointVector& a, const JointVector& b) {
   return a.size() == b.size() && (a - b).cwiseAbs().maxCoeff() <= 1e-9;

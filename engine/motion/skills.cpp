@@ -41,18 +41,20 @@ std::vector<JointVector> SegmentBuilder::BackOff(int robot, const JointVector& q
   // Longer first where the end of the usual length is in a tight pocket (free path searches
   // hardly leave one); then the usual length and shorter ones.
   std::vector<std::vector<JointVector>> longer;
-  for (double d : {opt_.approach_m, 2 * opt_.approach_m, 3 * opt_.approach_m}) {
+  for (double d :
+       {opt_.skills.approach_m, 2 * opt_.skills.approach_m, 3 * opt_.skills.approach_m}) {
     std::vector<JointVector> out = straight(d);
     if (out.empty()) break;
     *length = d;
-    if (!Tight(robot, out.back()) || d > 2.5 * opt_.approach_m) return out;
+    if (!Tight(robot, out.back()) || d > 2.5 * opt_.skills.approach_m) return out;
     longer.push_back(std::move(out));
   }
   if (!longer.empty()) {
-    *length = opt_.approach_m * static_cast<double>(longer.size());
+    *length = opt_.skills.approach_m * static_cast<double>(longer.size());
     return longer.back();
   }
-  for (double d : {opt_.approach_m / 2, opt_.approach_m / 4, opt_.approach_m / 8}) {
+  for (double d :
+       {opt_.skills.approach_m / 2, opt_.skills.approach_m / 4, opt_.skills.approach_m / 8}) {
     std::vector<JointVector> out = straight(d);
     if (out.empty()) continue;
     *length = d;
@@ -83,13 +85,13 @@ bool SegmentBuilder::Lift(int action, int node, const std::vector<int>& holders)
   // Straight up; else back along the first holder's approach axis when that leaves the table
   // upward; else up and sideways; else a shorter lift.
   const Vec3 back = -Tcp(holders[0], cur_[holders[0]]).linear().col(2);
-  std::vector<std::pair<Vec3, double>> moves = {{Vec3::UnitZ(), opt_.lift_m}};
-  if (back.z() > 0.3) moves.push_back({back, opt_.lift_m / back.z()});
+  std::vector<std::pair<Vec3, double>> moves = {{Vec3::UnitZ(), opt_.skills.lift_m}};
+  if (back.z() > 0.3) moves.push_back({back, opt_.skills.lift_m / back.z()});
   for (const Vec3& side :
        std::array<Vec3, 4>{Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0)}) {
-    moves.push_back({(side + Vec3::UnitZ()).normalized(), opt_.lift_m * std::sqrt(2.0)});
+    moves.push_back({(side + Vec3::UnitZ()).normalized(), opt_.skills.lift_m * std::sqrt(2.0)});
   }
-  moves.push_back({Vec3::UnitZ(), opt_.lift_m / 2});
+  moves.push_back({Vec3::UnitZ(), opt_.skills.lift_m / 2});
   std::string why;
   for (const auto& [dir, d] : moves) {
     std::vector<JointVector> q0;
@@ -217,7 +219,7 @@ bool SegmentBuilder::PlanPlaceDescent(int i, ActionWork& w) {
   cur_[r] = K.q[r];
   if (!SetScene(opening_, {}, {w.grasped})) return false;
   const Iso3 X0 = Tcp(r, K.q[r]);
-  const double d = opt_.lift_m;
+  const double d = opt_.skills.lift_m;
   auto path = Track({r}, {K.q[r]}, {[X0, d](double s) {
                       Iso3 X = X0;
                       X.translation().z() += s * d;
@@ -338,7 +340,7 @@ bool SegmentBuilder::HoverAbove(int action, Keyframe& goal, std::vector<int>& ho
   if (back.norm() > 1e-6) dirs.push_back((Vec3::UnitZ() + back.normalized()).normalized());
   std::string why = "no IK solution along the line";
   for (const Vec3& dir : dirs) {
-    for (double d : {opt_.lift_m, 2 * opt_.lift_m, opt_.lift_m / 2}) {
+    for (double d : {opt_.skills.lift_m, 2 * opt_.skills.lift_m, opt_.skills.lift_m / 2}) {
       const double len = d / dir.z();
       std::vector<std::function<Iso3(double)>> targets;
       for (int r : holders) {

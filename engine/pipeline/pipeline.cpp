@@ -83,6 +83,8 @@ class MotionQueue {
               const PipelineOptions& options, const TaskWorld& world, RunContext& ctx)
       : project_(project), check_(check), pre_(pre), options_(options), world_(world), ctx_(ctx) {
     motion_ = options.motion;
+    // One meaning of the skill lengths and the robots' clearance: the task planner's.
+    motion_.skills = options.task.skills;
     motion_.segment_checks = std::max(1LL, std::llround(motion_.segment_checks * options.budget));
     motion_.carry_edges =
         std::max(1, static_cast<int>(std::lround(motion_.carry_edges * options.budget)));
@@ -160,7 +162,9 @@ Result<void> MotionQueue::Enqueue(Plan plan) {
                   "optimising the joint keyframes of task plan " + std::to_string(made_) + " (" +
                       std::to_string(plan.actions.size()) + " actions)");
     const auto t0 = std::chrono::steady_clock::now();
-    auto report = OptimizeKeyframes(world_, plan, options_.keyframes, ctx_);
+    KeyframeOptOptions keyframes = options_.keyframes;
+    keyframes.min_clearance_m = options_.task.skills.robot_clearance_m;  // the task planner's
+    auto report = OptimizeKeyframes(world_, plan, keyframes, ctx_);
     t_kf_ += Since(t0);
     if (!report) {
       if (report.error().code == ErrorCode::kCancelled) return std::unexpected(report.error());

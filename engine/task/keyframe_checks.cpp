@@ -19,12 +19,8 @@ namespace wrap {
 namespace {
 
 // The straight moves that the motion stage makes at a keyframe as skills (a gripper's approach
-// to its grasp along its axis, a placement's descent) must be clear for at least this length
-// [m], checked at kStraightSamples points.
-constexpr double kStraightM = 0.02;
-// A retreat needs less: a release is permanent (nothing to sample), and a gripper near the table
-// still backs off a centimetre where two would hit it.
-constexpr double kRetreatM = 0.01;
+// to its grasp along its axis, a placement's descent, a freed gripper's retreat) are checked
+// clear for their least lengths (TaskPlannerOptions::skills) at this many points.
 constexpr int kStraightSamples = 4;
 
 }  // namespace
@@ -173,8 +169,8 @@ bool KeyframeSolver::CarryClear(int node, const std::vector<int>& holders,
 
 bool KeyframeSolver::RobotsTooClose() {
   DistanceRequest request;
-  request.upper_bound_m = options_.min_clearance_m * 2 + 0.01;
-  return cell_.MinRobotClearance(request).distance < options_.min_clearance_m;
+  request.upper_bound_m = options_.skills.robot_clearance_m * 2 + 0.01;
+  return cell_.MinRobotClearance(request).distance < options_.skills.robot_clearance_m;
 }
 
 bool KeyframeSolver::KeyframeClear(Edge& e, const Problem& p, Attempt& t,
@@ -182,7 +178,7 @@ bool KeyframeSolver::KeyframeClear(Edge& e, const Problem& p, Attempt& t,
   if (e.n_robots >= 2 && RobotsTooClose()) {
     t.gate = Gate::kClearance;
     t.message = "robots closer than " +
-                std::to_string(options_.min_clearance_m * 1000).substr(0, 4) + " mm";
+                std::to_string(options_.skills.robot_clearance_m * 1000).substr(0, 4) + " mm";
     return false;
   }
   if (!SkillsClear(e, p, t, q)) return false;
@@ -208,7 +204,7 @@ bool KeyframeSolver::SkillsClear(const Edge& e, const Problem& p, Attempt& t,
     if (!grasps) continue;
     const TaskRobot& R = world_.robots[r];
     const Vec3 back = -TcpPose(R.chain, R.X_WB, q[i], R.end_effector.X_FT).linear().col(2);
-    if (!StraightClear(r, q[i], back, kStraightM, &why_straight)) {
+    if (!StraightClear(r, q[i], back, options_.skills.min_straight_m, &why_straight)) {
       t.gate = Gate::kSkill;
       t.message = "'" + R.name + "' cannot approach its grasp straight along the " +
                   "gripper axis: " + why_straight;
@@ -226,7 +222,8 @@ bool KeyframeSolver::SkillsClear(const Edge& e, const Problem& p, Attempt& t,
       // The descent onto the table, seen from the bottom: the object rides along.
       const auto& parts = world_.tree->nodes[a.obj].parts;
       for (int part : parts) cell_.Attach(part, r);
-      const bool down = StraightClear(r, qr, Vec3::UnitZ(), kStraightM, &why_straight);
+      const bool down =
+          StraightClear(r, qr, Vec3::UnitZ(), options_.skills.min_straight_m, &why_straight);
       for (int part : parts) {
         cell_.Detach(part, r);
         cell_.world().SetAllowed(cell_.object_body(part), cell_.end_effector_body(r), true);
@@ -237,7 +234,8 @@ bool KeyframeSolver::SkillsClear(const Edge& e, const Problem& p, Attempt& t,
         return false;
       }
     }
-    if (!StraightClear(r, qr, -X_WT.linear().col(2), kRetreatM, &why_straight)) {
+    if (!StraightClear(r, qr, -X_WT.linear().col(2), options_.skills.min_retreat_m,
+                       &why_straight)) {
       t.gate = Gate::kSkill;
       t.message = "'" + R.name + "' cannot back its gripper away straight after " +
                   "letting go: " + why_straight;

@@ -154,7 +154,7 @@ bool KeyframeSolver::GrippersApart(int robot_a, int grasp_a, int robot_b, int gr
     }
   }
   CollisionRequest request;
-  request.margin_m = options_.min_clearance_m;
+  request.margin_m = options_.skills.robot_clearance_m;
   for (BodyId a : bodies[0]) {
     for (BodyId b : bodies[1]) {
       if (w.Collide(a, b, request)) return false;

@@ -184,7 +184,7 @@ Result<void> CheckOptions(const TaskPlannerOptions& options) {
     return Fail(ErrorCode::kInvalidInput, "planner: --force-scale must be finite and >= 0");
   }
   if (options.max_effort < 0 || options.max_effort > 2 || options.max_holders < 1 ||
-      options.max_nodes < 100 || !(options.min_clearance_m >= 0.0) || options.memory_limit_mb < 1) {
+      options.max_nodes < 100 || !(options.skills.robot_clearance_m >= 0.0) || options.memory_limit_mb < 1) {
     return Fail(ErrorCode::kInvalidInput, "planner: options out of range");
   }
   return {};

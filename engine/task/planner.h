@@ -33,6 +33,7 @@
 #include "model/project.h"
 #include "model/validate.h"
 #include "task/plan.h"
+#include "task/skill_geometry.h"
 #include "wrench/wrench.h"
 
 namespace wrap {
@@ -67,9 +68,10 @@ struct TaskPlannerOptions {
   /// it the run stops with "out of memory" in stats.failure.
   long long memory_limit_mb = 4096;
   MatingWrenchMode wrench_mode = MatingWrenchMode::kFull;  ///< full, gravity or none.
-  double force_scale = 1.0;        ///< Lambda on the mating force and torque, >= 0.
-  double min_clearance_m = 0.005;  ///< Least distance between two robots at a keyframe [m].
-  int max_effort = 2;              ///< Highest effort level (0-based) of the IK and pose sampling.
+  double force_scale = 1.0;  ///< Lambda on the mating force and torque, >= 0.
+  /// Skill lengths and the robots' clearance at keyframes (shared with the motion stage).
+  SkillGeometry skills;
+  int max_effort = 2;  ///< Highest effort level (0-based) of the IK and pose sampling.
   /// Widen the grasp and placement subsets when a milestone fails; absent: the project's
   /// `planner.widen_grasps`.
   std::optional<bool> widen;

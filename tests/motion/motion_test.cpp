@@ -524,7 +524,7 @@ TEST(Motion, AFailureCarriesTheCellWhereItHappened) {
   const Planned& p = PlanOnce("half_stool");
   ASSERT_TRUE(p.error.empty()) << p.error;
   MotionOptions options;
-  options.approach_m = 5.0;
+  options.skills.approach_m = 5.0;
   Plan plan = *p.plan;
   plan.trajectories.clear();
   plan.segments.clear();
