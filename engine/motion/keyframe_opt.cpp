@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <limits>
 #include <map>
-#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -18,6 +17,7 @@
 #include "robot/cell.h"
 #include "robot/ik.h"
 #include "robot/kinematics.h"
+#include "task/plan_state.h"
 
 namespace wrap {
 namespace {
@@ -65,12 +65,6 @@ struct Stage {
 struct RobotStages {
   std::vector<Stage> stages;
   std::vector<int> choice;  // per stage: index into its candidates
-};
-
-// Where held objects are, per robot: node and grasp.
-struct Holding {
-  int node = -1;
-  PlanGrasp grasp;
 };
 
 double RotationAngle(const Iso3& a, const Iso3& b) {
@@ -218,9 +212,7 @@ Result<int> Optimizer::CellFor(const std::vector<double>& opening) {
 }
 
 Result<void> Optimizer::BuildSequence() {
-  std::vector<std::optional<Holding>> holding(n_robots_);
-  auto add = [&](Keyframe* kf, int action, bool approach,
-                 const std::vector<std::optional<Holding>>& holds) -> Result<void> {
+  auto add = [&](Keyframe* kf, int action, bool approach, const PlanState& at) -> Result<void> {
     KeyframeInfo info;
     info.kf = kf;
     info.action = action;
@@ -228,10 +220,10 @@ Result<void> Optimizer::BuildSequence() {
     info.held_part.assign(n_robots_, -1);
     info.opening.assign(n_robots_, -1.0);
     for (int r = 0; r < n_robots_; ++r) {
-      if (!holds[r]) continue;
-      info.held_part[r] = holds[r]->grasp.part;
+      if (at.held[r] < 0) continue;
+      info.held_part[r] = at.grasp[r].part;
       if (world_.robots[r].end_effector.kind == EndEffectorKind::kTwoFinger) {
-        info.opening[r] = holds[r]->grasp.width_m + 2.0 * kFingerClearanceM;
+        info.opening[r] = at.grasp[r].width_m + 2.0 * kFingerClearanceM;
       }
     }
     for (const PlanObject& o : kf->objects) {
@@ -245,58 +237,17 @@ Result<void> Optimizer::BuildSequence() {
     sequence_.push_back(std::move(info));
     return {};
   };
-  if (auto ok = add(&plan_.initial, -1, false, holding); !ok) return ok;
+  PlanState state = InitialPlanState(plan_.initial, n_robots_);
+  if (auto ok = add(&plan_.initial, -1, false, state); !ok) return ok;
   for (size_t i = 0; i < plan_.actions.size(); ++i) {
     PlanAction& a = plan_.actions[i];
-    const int o = a.objects[0];
-    // The grasp of an acting robot, from the action.
-    auto grasp_of = [&](int robot) -> std::optional<PlanGrasp> {
-      for (const PlanHold& h : a.grasps) {
-        if (h.robot == robot) return h.grasp;
-      }
-      return std::nullopt;
-    };
-    // Holds at the keyframe: those before the action and the grasps it closes.
-    std::vector<std::optional<Holding>> holds = holding;
-    for (int r : a.robots) {
-      if (holds[r]) {
-        if (auto g = grasp_of(r)) holds[r]->grasp = *g;
-      }
-    }
-    const bool closes = a.type == ActionType::kPick || a.type == ActionType::kAddGrasp ||
-                        a.type == ActionType::kHandover;
-    const int closer =
-        a.type == ActionType::kHandover ? (a.robots.size() > 1 ? a.robots[1] : -1) : a.robots[0];
-    if (closes && closer >= 0) {
-      if (auto g = grasp_of(closer)) holds[closer] = Holding{o, *g};
-    }
+    // Who holds what at the approach and the keyframe: the grasps the action closes are closed.
+    const PlanState at = StateAtKeyframe(state, a);
     if (a.approach) {
-      if (auto ok = add(&*a.approach, static_cast<int>(i), true, holds); !ok) return ok;
+      if (auto ok = add(&*a.approach, static_cast<int>(i), true, at); !ok) return ok;
     }
-    if (auto ok = add(&a.keyframe, static_cast<int>(i), false, holds); !ok) return ok;
-    // Effects.
-    switch (a.type) {
-      case ActionType::kPick:
-      case ActionType::kAddGrasp:
-        holding[closer] = holds[closer];
-        break;
-      case ActionType::kPlace:
-      case ActionType::kRelease:
-        holding[a.robots[0]].reset();
-        break;
-      case ActionType::kHandover:
-        holding[a.robots[0]].reset();
-        if (closer >= 0) holding[closer] = holds[closer];
-        break;
-      case ActionType::kAssemble:
-        for (int r = 0; r < n_robots_; ++r) {
-          if (holds[r] && (holds[r]->node == a.objects[0] || holds[r]->node == a.objects[1])) {
-            holding[r] = holds[r];
-            holding[r]->node = a.objects[2];
-          }
-        }
-        break;
-    }
+    if (auto ok = add(&a.keyframe, static_cast<int>(i), false, at); !ok) return ok;
+    state = ApplyAction(state, a);
   }
   return {};
 }

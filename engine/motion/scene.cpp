@@ -14,69 +14,6 @@ namespace {
 constexpr double kFingerClearanceM = 1e-3;
 }  // namespace
 
-std::vector<int> PlanState::Holders(int node) const {
-  std::vector<int> out;
-  for (size_t r = 0; r < held.size(); ++r) {
-    if (held[r] == node) out.push_back(static_cast<int>(r));
-  }
-  return out;
-}
-
-std::vector<PlanState> ReplayPlanStates(const Plan& plan) {
-  const size_t n_robots = plan.robots.size();
-  std::vector<PlanState> out;
-  PlanState s;
-  s.held.assign(n_robots, -1);
-  s.grasp.assign(n_robots, PlanGrasp{});
-  for (const PlanObject& o : plan.initial.objects) s.objects[o.node] = o;
-  out.push_back(s);
-  for (const PlanAction& a : plan.actions) {
-    // Poses at the keyframe.
-    for (const PlanObject& o : a.keyframe.objects) {
-      if (auto it = s.objects.find(o.node); it != s.objects.end()) it->second.X_WA = o.X_WA;
-    }
-    switch (a.type) {
-      case ActionType::kPick:
-      case ActionType::kAddGrasp: {
-        const int r = a.robots[0];
-        s.held[r] = a.objects[0];
-        s.grasp[r] = a.grasps[0].grasp;
-        if (a.type == ActionType::kPick) s.objects[a.objects[0]].resting = false;
-        break;
-      }
-      case ActionType::kPlace: {
-        s.held[a.robots[0]] = -1;
-        s.objects[a.objects[0]].resting = true;
-        break;
-      }
-      case ActionType::kRelease:
-        s.held[a.robots[0]] = -1;
-        break;
-      case ActionType::kHandover:
-        s.held[a.robots[0]] = -1;
-        s.held[a.robots[1]] = a.objects[0];
-        s.grasp[a.robots[1]] = a.grasps[1].grasp;
-        break;
-      case ActionType::kAssemble: {
-        const int m = a.objects[0];
-        const int b = a.objects[1];
-        const int result = a.objects[2];
-        PlanObject merged = s.objects[b];
-        merged.node = result;
-        for (int& h : s.held) {
-          if (h == m || h == b) h = result;
-        }
-        s.objects.erase(m);
-        s.objects.erase(b);
-        s.objects[result] = merged;
-        break;
-      }
-    }
-    out.push_back(s);
-  }
-  return out;
-}
-
 double GraspOpening(const TaskRobot& robot, const PlanGrasp& grasp) {
   if (robot.end_effector.kind != EndEffectorKind::kTwoFinger) return -1.0;
   return grasp.width_m + 2.0 * kFingerClearanceM;

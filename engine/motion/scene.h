@@ -2,6 +2,7 @@
 // where the resting ones are, which robot carries which object with which grasp, the fingers'
 // openings, and the contacts a motion may make (a held part with its gripper, the parts of one
 // object, the two inputs of an insertion, an object on the table during a lift or a descent).
+// The plan state it is posed at (who holds what, where the objects are) is task/plan_state.h's.
 #pragma once
 
 #include <map>
@@ -13,25 +14,10 @@
 #include "geometry/mesh.h"
 #include "robot/cell.h"
 #include "task/plan.h"
+#include "task/plan_state.h"
 #include "task/world.h"
 
 namespace wrap {
-
-/// What exists and who holds what between two events of a plan.
-struct PlanState {
-  std::map<int, PlanObject> objects;  ///< By node id: pose of its assembly frame, resting or not.
-  std::vector<int> held;              ///< Per robot: node id of the object it holds, -1 none.
-  std::vector<PlanGrasp> grasp;       ///< Per robot: its grasp while `held[r] >= 0`.
-
-  /// The robots holding `node`, in robot order.
-  std::vector<int> Holders(int node) const;
-};
-
-/// The state before the first action (states[0]) and after each action i (states[i + 1]), by the
-/// semantics of task/plan.h: pick, add_grasp and handover give a grasp, place, release and
-/// handover take one, assemble replaces M and B by S (pose of B, resting when B rests) held by
-/// every robot that held M or B. Object poses are the keyframe's.
-std::vector<PlanState> ReplayPlanStates(const Plan& plan);
 
 /// The finger opening a robot uses with `grasp`: its width plus the grasp sampler's clearance on
 /// each side (two-finger), -1 (fully open, or vacuum) otherwise.

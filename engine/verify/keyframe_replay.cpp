@@ -1,3 +1,5 @@
+// The keyframe replay of a plan without motion: a Timer walks the actions in plan order and
+// gives every robot a timed trajectory (see detail/keyframe_replay.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -8,6 +10,7 @@
 
 #include "robot/ik.h"
 #include "robot/kinematics.h"
+#include "task/plan_state.h"
 #include "verify/detail/keyframe_replay.h"
 
 namespace wrap::detail {
@@ -25,8 +28,7 @@ class Timer {
     q_ = plan_.initial.q;
     opening_.assign(nr, -1.0);
     lifted_.assign(nr, std::nullopt);
-    holding_.assign(nr, -1);
-    grasp_.assign(nr, PlanGrasp{});
+    state_ = InitialPlanState(plan_.initial, nr);
     plan_.trajectories.assign(nr, RobotTrajectory{});
     plan_.segments.clear();
     for (int r = 0; r < nr; ++r) {
@@ -116,8 +118,8 @@ class Timer {
         V = std::min(V, chain.joints[j].max_velocity / dj);
         A = std::min(A, chain.joints[j].max_acceleration / dj);
       }
-      tcp_length = std::max(
-          tcp_length, (Tcp(r, target[k]).translation() - Tcp(r, q_[r]).translation()).norm());
+      tcp_length = std::max(tcp_length,
+                            (Tcp(r, target[k]).translation() - Tcp(r, q_[r]).translation()).norm());
     }
     if (!moves) return;
     if (speed_mps > 0.0 && tcp_length > 1e-9) V = std::min(V, speed_mps / tcp_length);
@@ -155,11 +157,11 @@ class Timer {
 
   // Lowest world z of what robot r holds when at q (+inf when it holds nothing).
   double LowestHeld(int r, const JointVector& q) const {
-    if (holding_[r] < 0) return std::numeric_limits<double>::infinity();
-    const PlanGrasp& g = grasp_[r];
+    if (state_.held[r] < 0) return std::numeric_limits<double>::infinity();
+    const PlanGrasp& g = state_.grasp[r];
     const Iso3 X_WA = Tcp(r, q) * (scene_.parts[g.part].X_AP * g.X_PG).inverse();
     double lowest = std::numeric_limits<double>::infinity();
-    for (int p : tree_.nodes[holding_[r]].parts) {
+    for (int p : tree_.nodes[state_.held[r]].parts) {
       const Iso3 X_WP = X_WA * scene_.parts[p].X_AP;
       const auto& v = scene_.parts[p].mesh->vertices;
       const size_t step = std::max<size_t>(1, v.size() / 400);
@@ -201,7 +203,7 @@ class Timer {
         robots.push_back(static_cast<int>(r));
         goals.push_back(target[r]);
         starts.push_back(q_[r]);
-        carries = carries || holding_[r] >= 0;
+        carries = carries || state_.held[r] >= 0;
       }
     }
     if (robots.empty()) return;
@@ -290,28 +292,7 @@ class Timer {
         break;
     }
     for (int r : a.robots) Idle(r, t_);
-    // Who holds what from now on.
-    auto hold = [&](size_t k, int node) {
-      holding_[a.robots[k]] = node;
-      grasp_[a.robots[k]] = a.grasps[k].grasp;
-    };
-    switch (a.type) {
-      case ActionType::kPick:
-      case ActionType::kAddGrasp:
-        hold(0, a.objects[0]);
-        break;
-      case ActionType::kHandover:
-        holding_[a.robots[0]] = -1;
-        hold(1, a.objects[0]);
-        break;
-      case ActionType::kPlace:
-      case ActionType::kRelease:
-        holding_[a.robots[0]] = -1;
-        break;
-      case ActionType::kAssemble:
-        for (size_t k = 0; k < a.robots.size(); ++k) hold(k, a.objects[2]);
-        break;
-    }
+    state_ = ApplyAction(state_, a);  // who holds what from now on
     if (a.type == ActionType::kPick) {
       const int r = a.robots[0];
       if (auto q = Shifted(r, q_[r], up)) {
@@ -335,8 +316,7 @@ class Timer {
   std::vector<double> opening_;  // per robot, its finger opening from t_ on
   // Per robot after a lift: its joints at the pick and lifted, until a keyframe moves it.
   std::vector<std::optional<std::pair<JointVector, JointVector>>> lifted_;
-  std::vector<int> holding_;       // per robot, the node it holds, -1 none
-  std::vector<PlanGrasp> grasp_;   // per robot, its grasp while holding
+  PlanState state_;  // who holds what from t_ on
   double t_ = 0.0;
   std::mt19937_64 rng_{1};
 };

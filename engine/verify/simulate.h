@@ -91,7 +91,7 @@ struct SimActionStatus {
 
 /// Why a plan failed in simulation.
 struct SimFailure {
-  int action = -1;     ///< Index of the action blamed.
+  int action = -1;  ///< Index of the action blamed.
   /// "no support", "slip", "vacuum limit", "collision", "misalignment".
   std::string reason;
   std::string detail;  ///< In words: which part or robot, the numbers seen.
@@ -118,10 +118,10 @@ struct SimReport {
   long long collision_checks = 0;  ///< Moments checked for collisions.
   /// Measurements in which a gripper beyond its limits as MuJoCo's rigid welds split its
   /// object's load was judged by the best split among the object's supports instead (its other
-  /// grippers, its table contacts: an LP, see simulate.cpp BestSplit). 0 when none.
+  /// grippers, its table contacts: an LP, see sim_measure.cpp BestSplit). 0 when none.
   long long split_measurements = 0;
-  std::vector<std::string> notes;  ///< What the run approximated (keyframe replay).
-  std::vector<std::string> warnings;            ///< MuJoCo warnings, approximated meshes.
+  std::vector<std::string> notes;     ///< What the run approximated (keyframe replay).
+  std::vector<std::string> warnings;  ///< MuJoCo warnings, approximated meshes.
 };
 
 /// Simulates `plan` of `project` (validated: `check` holds its meshes and tree; `project_file`

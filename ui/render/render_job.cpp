@@ -7,13 +7,13 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <map>
 
 #include "render/contact_sheet.h"
 #include "render/renderer.h"
 #include "render/video.h"
 #include "robot/kinematics.h"
 #include "sim/mujoco_model.h"
+#include "task/plan_state.h"
 
 namespace wrap::render {
 
@@ -301,40 +301,26 @@ std::vector<PlanTimelineEntry> PlanTimeline(const Plan& plan) {
 
 Result<std::vector<SceneState>> PlanStates(const CellScene& scene, const AssemblyTree& tree,
                                            const Plan& plan) {
-  // Who holds what, replayed action by action: the grasp each robot holds, if any.
-  std::vector<std::optional<PlanGrasp>> holds(scene.robots.size());
-  auto openings = [&] {
-    std::vector<double> opening(scene.robots.size());
-    for (size_t r = 0; r < scene.robots.size(); ++r) {
+  const int n_robots = static_cast<int>(scene.robots.size());
+  // Fingers closed to the grasp's width on what a robot holds, else fully open.
+  auto openings = [&](const PlanState& s) {
+    std::vector<double> opening(n_robots);
+    for (int r = 0; r < n_robots; ++r) {
       const double stroke = scene.robots[r].end_effector.stroke_m;
-      opening[r] = holds[r] ? std::clamp(holds[r]->width_m, 0.0, stroke) : stroke;
+      opening[r] = s.held[r] >= 0 ? std::clamp(s.grasp[r].width_m, 0.0, stroke) : stroke;
     }
     return opening;
   };
+  // Who holds what, replayed action by action (task/plan_state.h): from an action's approach
+  // through its keyframe its grasps are closed; after the keyframe its grippers let go.
+  PlanState before = InitialPlanState(plan.initial, n_robots);
   std::vector<SceneState> states;
   for (const PlanTimelineEntry& e : PlanTimeline(plan)) {
-    if (e.action >= 0) {
-      // From the approach (the holders already hold) and at the keyframe (new grasps closed),
-      // every acting robot has the grasp the action lists for it (plan.h).
-      const PlanAction& a = plan.actions[e.action];
-      for (size_t k = 0; k < a.robots.size() && k < a.grasps.size(); ++k) {
-        const int r = a.robots[k];
-        if (r >= 0 && r < static_cast<int>(holds.size())) holds[r] = a.grasps[k].grasp;
-      }
-    }
-    auto state = KeyframeState(scene, tree, KeyframeOf(plan, e), EntryName(e), openings());
+    const PlanState at = e.action >= 0 ? StateAtKeyframe(before, plan.actions[e.action]) : before;
+    auto state = KeyframeState(scene, tree, KeyframeOf(plan, e), EntryName(e), openings(at));
     if (!state) return std::unexpected(state.error());
     states.push_back(std::move(*state));
-    if (e.action >= 0 && !e.approach) {
-      // After the keyframe: who lets go.
-      const PlanAction& a = plan.actions[e.action];
-      const bool lets_go = a.type == ActionType::kPlace || a.type == ActionType::kRelease ||
-                           a.type == ActionType::kHandover;
-      if (lets_go && !a.robots.empty() && a.robots[0] >= 0 &&
-          a.robots[0] < static_cast<int>(holds.size())) {
-        holds[a.robots[0]].reset();
-      }
-    }
+    if (e.action >= 0 && !e.approach) before = ApplyAction(before, plan.actions[e.action]);
   }
   return states;
 }
@@ -362,75 +348,29 @@ Result<SceneState> MotionState(const CellScene& scene, const AssemblyTree& tree,
     X_WT[r] = TcpPose(robot.chain, robot.X_WB, state.q.back(), robot.end_effector.X_FT);
   }
   // Objects: replay the actions whose moments have passed (in time order).
-  struct Object {
-    Iso3 X_WA;
-    std::vector<int> holders;  // in robot order; the first carries it
-  };
-  std::map<int, Object> objects;
-  std::vector<PlanGrasp> grasp(n_robots);
-  for (const PlanObject& o : plan.initial.objects) objects[o.node] = {o.X_WA, {}};
   std::vector<int> order(plan.actions.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return plan.actions[a].end_s < plan.actions[b].end_s; });
-  auto pose_now = [&](const Object& o) {
-    if (o.holders.empty()) return o.X_WA;
-    const PlanGrasp& g = grasp[o.holders.front()];
-    return X_WT[o.holders.front()] * (scene.parts[g.part].X_AP * g.X_PG).inverse();
-  };
+  PlanState s = InitialPlanState(plan.initial, static_cast<int>(n_robots));
   for (int i : order) {
-    const PlanAction& a = plan.actions[i];
-    if (a.end_s > t) break;
-    const int node = a.objects.empty() ? -1 : a.objects[0];
-    auto keyframe_pose = [&](int n) {
-      for (const PlanObject& o : a.keyframe.objects) {
-        if (o.node == n) return o.X_WA;
-      }
-      return objects[n].X_WA;
-    };
-    auto drop = [&](int r) {
-      auto& h = objects[node].holders;
-      h.erase(std::remove(h.begin(), h.end(), r), h.end());
-    };
-    auto take = [&](int r, const PlanGrasp& g) {
-      auto& h = objects[node].holders;
-      h.push_back(r);
-      std::sort(h.begin(), h.end());
-      grasp[r] = g;
-    };
-    switch (a.type) {
-      case ActionType::kPick:
-      case ActionType::kAddGrasp:
-        take(a.robots[0], a.grasps[0].grasp);
-        break;
-      case ActionType::kPlace:
-      case ActionType::kRelease:
-        objects[node].X_WA = keyframe_pose(node);
-        drop(a.robots[0]);
-        break;
-      case ActionType::kHandover:
-        drop(a.robots[0]);
-        take(a.robots[1], a.grasps[1].grasp);
-        break;
-      case ActionType::kAssemble: {
-        Object merged{keyframe_pose(a.objects[1]), {}};
-        for (int n : {a.objects[0], a.objects[1]}) {
-          for (int r : objects[n].holders) merged.holders.push_back(r);
-          objects.erase(n);
-        }
-        std::sort(merged.holders.begin(), merged.holders.end());
-        objects[a.objects[2]] = merged;
-        break;
-      }
-    }
+    if (plan.actions[i].end_s > t) break;
+    s = ApplyAction(s, plan.actions[i]);
   }
+  // Where an object is now: carried by its first holder, else where the plan left it.
+  auto pose_now = [&](int node, const PlanObject& o) {
+    const std::vector<int> holders = s.Holders(node);
+    if (holders.empty()) return o.X_WA;
+    const PlanGrasp& g = s.grasp[holders.front()];
+    return X_WT[holders.front()] * (scene.parts[g.part].X_AP * g.X_PG).inverse();
+  };
   state.X_WP.assign(scene.parts.size(), Iso3::Identity());
-  for (const auto& [n, o] : objects) {
+  for (const auto& [n, o] : s.objects) {
     if (n < 0 || n >= static_cast<int>(tree.nodes.size())) {
       return Fail(ErrorCode::kInvalidInput,
                   "plan: object node " + std::to_string(n) + " is not in the assembly");
     }
-    const Iso3 X_WA = pose_now(o);
+    const Iso3 X_WA = pose_now(n, o);
     for (int p : tree.nodes[n].parts) state.X_WP[p] = X_WA * scene.parts[p].X_AP;
   }
   return state;
