@@ -46,6 +46,10 @@ const PlanObject* KeyframeObject(const Keyframe& k, int node) {
   return nullptr;
 }
 
+// Who holds what after action `a`, replayed independently of task/plan_state.h's ApplyAction on
+// purpose: this check verifies motion built from ApplyAction's states and must not share its
+// code. Like the simulation and the renderer's motion view it applies actions in time order
+// (end_s). Keep it in step with plan.h's semantics.
 void Apply(Replay& s, const PlanAction& a) {
   auto drop = [&](int node, int r) {
     auto& h = s.things[node].holders;

@@ -7,7 +7,10 @@
 // state-update code (task/state.h, task/world.h and friends) but keeps its own objects, holders
 // and joints, so that a bug in the planner's model of an action cannot hide by being repeated
 // here. (The plan module does not link the task module, so such a call would not even build.)
-// When the semantics of an action change, change the planner and this replay separately.
+// Nor does it use task/plan_state.h's ApplyAction, which the motion scene, the keyframe
+// optimisation, the simulation and the renderer share: the validator checks plans against
+// plan.h's semantics and must not reuse the code it checks. When the semantics of an action
+// change, change plan.h, ApplyAction, the planner and this replay, each on its own.
 #include <map>
 #include <set>
 #include <string>

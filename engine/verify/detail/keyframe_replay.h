@@ -14,7 +14,7 @@
 
 namespace wrap::detail {
 
-/// Options of TimeKeyframes (the motion stage's skill defaults, motion/segments.h).
+/// Options of TimeKeyframes (the motion stage's skill defaults, motion/motion_options.h).
 struct KeyframeReplayOptions {
   double lift_m = 0.05;            ///< Straight lift after a pick, descent before a place [m].
   double skill_speed_mps = 0.05;   ///< TCP speed of a lift or descent [m/s].
