@@ -227,6 +227,61 @@ std::optional<SoleCarry> CarriedAlone(const TaskWorld& w, const Plan& plan,
   return c;
 }
 
+// The plan as text, for the golden files (tests/golden/plans/NAME.txt): the run's outcome, each
+// action in words with its robots' keyframe joints, each robot's trajectory summarised. Numbers
+// are rounded (joints to 1e-4 rad, times to 1 ms) so that the text survives last-bit
+// differences of libm between machines, not a change of plan.
+std::string PlanFingerprint(const Plan& plan) {
+  std::string text = StrFormat("solved %d, cost %d, task plans %d, suspensions %d\n",
+                               plan.stats.solved ? 1 : 0, static_cast<int>(plan.actions.size()),
+                               plan.stats.task_plans, plan.stats.motion_suspensions);
+  for (size_t i = 0; i < plan.actions.size(); ++i) {
+    const PlanAction& a = plan.actions[i];
+    text += StrFormat("%zu %s\n", i + 1, DescribeAction(plan, a).c_str());
+    for (int r : a.robots) {
+      text += "  " + plan.robots[r] + ":";
+      for (int j = 0; j < a.keyframe.q[r].size(); ++j) {
+        text += StrFormat(" %.4f", a.keyframe.q[r][j] + 0.0);
+      }
+      text += StrFormat(" @ %.3f s\n", a.end_s);
+    }
+  }
+  for (size_t r = 0; r < plan.trajectories.size(); ++r) {
+    const auto& knots = plan.trajectories[r].knots;
+    double sum_q = 0.0;
+    for (const TrajectoryKnot& k : knots) sum_q += k.q.cwiseAbs().sum();
+    text += StrFormat("trajectory %s: %zu knots, ends at %.3f s, sum |q| %.3f\n",
+                      plan.robots[r].c_str(), knots.size(), knots.empty() ? 0.0 : knots.back().t,
+                      sum_q);
+  }
+  return text;
+}
+
+// Every example plans as its golden file says (same seed, same plan, on every machine and after
+// every refactoring). A plan that changes on purpose (a better planner) is regenerated with
+// WRAP_UPDATE_GOLDEN=1 (tests/golden/README.md); a failure writes the new text beside the build's
+// test output as NAME_actual.txt to diff against the golden one. (Part of the example's one test:
+// ctest runs every test in a process of its own, so a test of its own would plan it again.)
+void ExpectSameAsGoldenPlan(const std::string& name, const Plan& plan) {
+  const std::string actual = PlanFingerprint(plan);
+  const fs::path golden = fs::path(WRAP_SOURCE_DIR) / "tests/golden/plans" / (name + ".txt");
+  if (const char* update = std::getenv("WRAP_UPDATE_GOLDEN");
+      update && std::string(update) == "1") {
+    ASSERT_TRUE(WriteFileAtomic(golden, actual).has_value());
+    std::printf("rewrote %s\n", golden.string().c_str());
+    return;
+  }
+  auto expected = ReadFile(golden);
+  ASSERT_TRUE(expected.has_value())
+      << expected.error().message << " (create it with WRAP_UPDATE_GOLDEN=1, see "
+      << "tests/golden/README.md)";
+  if (*expected == actual) return;
+  const fs::path out = fs::temp_directory_path() / (name + "_actual.txt");
+  (void)WriteFileAtomic(out, actual);
+  ADD_FAILURE() << name << ": the plan differs from " << golden << "; the new one is in " << out
+                << " (diff them; if the change is on purpose, regenerate)";
+}
+
 class ExampleMotion : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ExampleMotion, TrajectoriesPassTheIndependentChecks) {
@@ -234,6 +289,7 @@ TEST_P(ExampleMotion, TrajectoriesPassTheIndependentChecks) {
   ASSERT_TRUE(p.error.empty()) << p.error;
   const Plan& plan = *p.plan;
   ASSERT_TRUE(plan.stats.solved) << plan.stats.failure;
+  ExpectSameAsGoldenPlan(GetParam(), plan);
   ASSERT_TRUE(plan.stats.motion);
   ASSERT_EQ(plan.trajectories.size(), plan.robots.size());
 
@@ -359,61 +415,6 @@ INSTANTIATE_TEST_SUITE_P(Examples, ExampleMotion,
                          ::testing::Values("stool", "stool_step", "half_stool", "chair", "cross",
                                            "cross_openarm", "cube", "cube_2x2x3", "fabrica_beam",
                                            "fabrica_plumbers_block"));
-
-// The plan as text, for the golden files (tests/golden/plans/NAME.txt): the run's outcome, each
-// action in words with its robots' keyframe joints, each robot's trajectory summarised. Numbers
-// are rounded (joints to 1e-4 rad, times to 1 ms) so that the text survives last-bit
-// differences of libm between machines, not a change of plan.
-std::string PlanFingerprint(const Plan& plan) {
-  std::string text = StrFormat("solved %d, cost %d, task plans %d, suspensions %d\n",
-                               plan.stats.solved ? 1 : 0, static_cast<int>(plan.actions.size()),
-                               plan.stats.task_plans, plan.stats.motion_suspensions);
-  for (size_t i = 0; i < plan.actions.size(); ++i) {
-    const PlanAction& a = plan.actions[i];
-    text += StrFormat("%zu %s\n", i + 1, DescribeAction(plan, a).c_str());
-    for (int r : a.robots) {
-      text += "  " + plan.robots[r] + ":";
-      for (int j = 0; j < a.keyframe.q[r].size(); ++j) {
-        text += StrFormat(" %.4f", a.keyframe.q[r][j] + 0.0);
-      }
-      text += StrFormat(" @ %.3f s\n", a.end_s);
-    }
-  }
-  for (size_t r = 0; r < plan.trajectories.size(); ++r) {
-    const auto& knots = plan.trajectories[r].knots;
-    double sum_q = 0.0;
-    for (const TrajectoryKnot& k : knots) sum_q += k.q.cwiseAbs().sum();
-    text += StrFormat("trajectory %s: %zu knots, ends at %.3f s, sum |q| %.3f\n",
-                      plan.robots[r].c_str(), knots.size(), knots.empty() ? 0.0 : knots.back().t,
-                      sum_q);
-  }
-  return text;
-}
-
-// Every example plans as its golden file says (same seed, same plan, on every machine and after
-// every refactoring). A plan that changes on purpose (a better planner) is regenerated with
-// WRAP_UPDATE_GOLDEN=1 (tests/golden/README.md); a failure writes the new text beside the build's
-// test output as NAME_actual.txt to diff against the golden one.
-TEST_P(ExampleMotion, SamePlanAsItsGoldenFile) {
-  const Planned& p = PlanOnce(GetParam());
-  ASSERT_TRUE(p.error.empty()) << p.error;
-  const std::string actual = PlanFingerprint(*p.plan);
-  const fs::path golden = fs::path(WRAP_SOURCE_DIR) / "tests/golden/plans" / (GetParam() + ".txt");
-  if (const char* update = std::getenv("WRAP_UPDATE_GOLDEN");
-      update && std::string(update) == "1") {
-    ASSERT_TRUE(WriteFileAtomic(golden, actual).has_value());
-    GTEST_SKIP() << "rewrote " << golden;
-  }
-  auto expected = ReadFile(golden);
-  ASSERT_TRUE(expected.has_value())
-      << expected.error().message << " (create it with WRAP_UPDATE_GOLDEN=1, see "
-      << "tests/golden/README.md)";
-  if (*expected == actual) return;
-  const fs::path out = fs::temp_directory_path() / (GetParam() + "_actual.txt");
-  (void)WriteFileAtomic(out, actual);
-  ADD_FAILURE() << GetParam() << ": the plan differs from " << golden << "; the new one is in "
-                << out << " (diff them; if the change is on purpose, regenerate)";
-}
 
 // Deterministic: the searches' budgets are work, not time (Load.SamePlanUnderACpuHog checks
 // that a loaded machine gives the same plan).
