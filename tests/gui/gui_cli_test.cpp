@@ -116,7 +116,7 @@ fs::path StoolWithoutItsTimeLimit(const fs::path& dir) {
 }
 
 TEST(GuiCli, ScreenshotOfTheStoolAfterPlanningAndScrubbing) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   const auto dir = ScratchDir("gui_cli_stool");
   const ProcessRun r = WrapUnderXvfb(dir, "'" + StoolWithoutItsTimeLimit(dir).string() +
                                               "' --run-plan --at 40 --screenshot shot.png --size " +
@@ -143,7 +143,7 @@ TEST(GuiCli, ScreenshotOfTheStoolAfterPlanningAndScrubbing) {
 }
 
 TEST(GuiCli, ScriptBuildsAProjectFromMeshesPlansAndSavesIt) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   const auto dir = ScratchDir("gui_cli_script");
   // The stool's cell (table, robots) without parts or steps.
   {
@@ -255,7 +255,7 @@ TEST(GuiCli, ScriptBuildsAProjectFromMeshesPlansAndSavesIt) {
 }
 
 TEST(GuiCli, BadScriptIsBadInputNamingTheLine) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   const auto dir = ScratchDir("gui_cli_bad_script");
   std::ofstream(dir / "bad.wrapscript") << "undo\nteleport seat\n";
   const ProcessRun r =
@@ -265,7 +265,7 @@ TEST(GuiCli, BadScriptIsBadInputNamingTheLine) {
 }
 
 TEST(GuiCli, AFailingScriptLineExitsOne) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   const auto dir = ScratchDir("gui_cli_failing_script");
   std::ofstream(dir / "f.wrapscript") << "add-edge stool seat+leg1\n";
   const ProcessRun r =
@@ -285,7 +285,7 @@ TEST(GuiCli, NoDisplayIsBadInputWithAHint) {
 }
 
 TEST(GuiCli, MissingProjectIsBadInput) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   const auto dir = ScratchDir("gui_cli_missing");
   const ProcessRun r = WrapUnderXvfb(dir, "nope.json --screenshot x.png");
   EXPECT_EQ(r.code, 2) << r.output;
@@ -309,7 +309,7 @@ std::string Slurp(const fs::path& file) {
 // the last edit, the project file is untouched, and opening the project again offers the
 // recovery, which gives back the edited project.
 TEST(GuiCli, KilledWhileEditingTheRecoveryFileHoldsTheLastEdit) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   const auto dir = ScratchDir("gui_cli_kill");
   {
     auto doc = Document::Open(ExampleProject("stool"));
@@ -381,7 +381,7 @@ namespace {
 // viewport into the failing state. Then the live validation lists a warning by entity name, and
 // a negative force typed into the mating editor is refused at the field.
 TEST(GuiCli, AFailedPlanIsExplainedWhereItHappened) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   const auto dir = ScratchDir("gui_cli_failure");
   // Only vacuum cups, and the first step needs a transverse force a cup cannot take while
   // mating: the planner stops at milestone 1 at once (task planner test: VacuumOnly...).
@@ -431,7 +431,7 @@ TEST(GuiCli, AFailedPlanIsExplainedWhereItHappened) {
 // an edit marks the plan out of date (not played as current) and undo makes it current again;
 // Save As keeps the undo history.
 TEST(GuiCli, NewAndEditsNeverShowAStalePicture) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   const auto dir = ScratchDir("gui_cli_stale");
   std::ofstream(dir / "empty.wrapscript") << "expect-viewport empty\nscreenshot empty.png\n";
   const ProcessRun e = WrapUnderXvfb(dir, "--script empty.wrapscript --size 1400x900");

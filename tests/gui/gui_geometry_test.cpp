@@ -39,7 +39,7 @@ long NearColour(const render::Image& im, int x0, int y0, int x1, int y1, int r, 
 constexpr int kVx0 = 330, kVy0 = 30, kVx1 = 1015, kVy1 = 580;
 
 TEST(GuiGeometry, ABlockedAxisShowsFreeDirectionsAndUsingOneMakesItClean) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   const auto dir = ScratchDir("gui_geometry_axis");
   std::ofstream(dir / "axis.wrapscript")
       << "select step seat+leg1\n"
@@ -99,49 +99,48 @@ fs::path ExportStool(const fs::path& dir) {
 }
 
 TEST(GuiGeometry, ImportAssemblySuggestOrderAndLayOutAreUndoableEdits) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   const auto dir = ScratchDir("gui_geometry_import");
   ExportStool(dir);
-  std::ofstream(dir / "import.wrapscript")
-      << "import-assembly auto meshes\n"
-      << "expect-count parts 5\n"
-      << "expect-count steps 4\n"
-      << "expect-count robots 4\n"
-      << "expect-undo import assembly (5 parts)\n"
-      << "expect-change part 'seat' added\n"
-      << "expect-change decided: unit: m\n"
-      << "validate\n"
-      << "expect-no-problem error\n"
-      << "expect-touch seat leg1\n"
-      << "screenshot imported.png\n"
-      << "delete-step s4_leg1\n"
-      << "delete-step s3_leg2\n"
-      << "expect-count steps 2\n"
-      << "suggest-order\n"
-      << "expect-count steps 4\n"
-      << "expect-undo suggest assembly order\n"
-      << "expect-change added\n"
-      << "validate\n"
-      << "expect-no-problem error\n"
-      << "set part.leg2.initial_xyz 0 0 0.75\n"
-      << "set part.leg3.initial_xyz 0 0 0.75\n"
-      << "lay-out\n"
-      << "expect-undo lay out parts on the table\n"
-      << "expect-change part 'leg2' moved on the table\n"
-      << "validate\n"
-      << "expect-no-problem error\n"
-      << "screenshot laid_out.png\n"
-      << "undo\n"
-      << "undo\n"
-      << "undo\n"
-      << "undo\n"
-      << "undo\n"
-      << "undo\n"
-      << "expect-count steps 4\n"  // as imported
-      << "undo\n"
-      << "expect-count parts 0\n"
-      << "redo\n"
-      << "expect-count parts 5\n";
+  std::ofstream(dir / "import.wrapscript") << "import-assembly auto meshes\n"
+                                           << "expect-count parts 5\n"
+                                           << "expect-count steps 4\n"
+                                           << "expect-count robots 4\n"
+                                           << "expect-undo import assembly (5 parts)\n"
+                                           << "expect-change part 'seat' added\n"
+                                           << "expect-change decided: unit: m\n"
+                                           << "validate\n"
+                                           << "expect-no-problem error\n"
+                                           << "expect-touch seat leg1\n"
+                                           << "screenshot imported.png\n"
+                                           << "delete-step s4_leg1\n"
+                                           << "delete-step s3_leg2\n"
+                                           << "expect-count steps 2\n"
+                                           << "suggest-order\n"
+                                           << "expect-count steps 4\n"
+                                           << "expect-undo suggest assembly order\n"
+                                           << "expect-change added\n"
+                                           << "validate\n"
+                                           << "expect-no-problem error\n"
+                                           << "set part.leg2.initial_xyz 0 0 0.75\n"
+                                           << "set part.leg3.initial_xyz 0 0 0.75\n"
+                                           << "lay-out\n"
+                                           << "expect-undo lay out parts on the table\n"
+                                           << "expect-change part 'leg2' moved on the table\n"
+                                           << "validate\n"
+                                           << "expect-no-problem error\n"
+                                           << "screenshot laid_out.png\n"
+                                           << "undo\n"
+                                           << "undo\n"
+                                           << "undo\n"
+                                           << "undo\n"
+                                           << "undo\n"
+                                           << "undo\n"
+                                           << "expect-count steps 4\n"  // as imported
+                                           << "undo\n"
+                                           << "expect-count parts 0\n"
+                                           << "redo\n"
+                                           << "expect-count parts 5\n";
   const ProcessRun r = WrapUnderXvfb(dir, "--script import.wrapscript --size 1400x900");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("step 1:"), std::string::npos) << r.output;

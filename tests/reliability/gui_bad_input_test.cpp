@@ -40,7 +40,7 @@ ProcessRun GuiUnderXvfb(const fs::path& dir, const std::string& project) {
 }
 
 TEST(GuiBadInput, MalformedProjectMeshAndUrdf) {
-  if (!HaveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
   struct Case {
     std::string name;
     std::string project;               ///< Project text ("" = the blocks project).

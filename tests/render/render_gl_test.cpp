@@ -46,7 +46,8 @@ TEST(OffscreenRenderer, FramesFollowTheState) {
   options.width = 160;
   options.height = 120;
   auto renderer = OffscreenRenderer::Create(*c.model, options);
-  if (!renderer) GTEST_SKIP() << "no EGL here: " << renderer.error().message;
+  ASSERT_TRUE(renderer) << "no EGL here (scripts/install_deps.sh installs it): "
+                        << renderer.error().message;
   const SceneState home = InitialState(c.scene);
   const CameraView camera = FrameBox(SceneBounds(c.scene, home), 150, -40, 40, 160.0 / 120.0);
   auto a = (*renderer)->Render(home, camera);
@@ -85,7 +86,7 @@ TEST(OffscreenRenderer, SizeBeyondTheModelBufferIsRejected) {
 
 TEST(GlContext, OneGlPlatformLibraryPerProcess) {
   auto egl = GlContext::Create(GlBackend::kEgl);
-  if (!egl) GTEST_SKIP() << "no EGL here: " << egl.error().message;
+  ASSERT_TRUE(egl) << "no EGL here (scripts/install_deps.sh installs it): " << egl.error().message;
   auto osmesa = GlContext::Create(GlBackend::kOsmesa);
   ASSERT_FALSE(osmesa.has_value());
   EXPECT_EQ(osmesa.error().code, ErrorCode::kInvalidInput);
