@@ -85,6 +85,8 @@ class MotionQueue {
     motion_ = options.motion;
     // One meaning of the skill lengths and the robots' clearance: the task planner's.
     motion_.skills = options.task.skills;
+    keyframes_ = options.keyframes;
+    keyframes_.min_clearance_m = options.task.skills.robot_clearance_m;
     motion_.segment_checks = std::max(1LL, std::llround(motion_.segment_checks * options.budget));
     motion_.carry_edges =
         std::max(1, static_cast<int>(std::lround(motion_.carry_edges * options.budget)));
@@ -141,6 +143,7 @@ class MotionQueue {
   const TaskWorld& world_;
   RunContext& ctx_;
   MotionOptions motion_;
+  KeyframeOptOptions keyframes_;  // options.keyframes with the task planner's clearance
   std::vector<Candidate> queue_;
   int made_ = 1;
   int suspensions_ = 0;
@@ -162,9 +165,7 @@ Result<void> MotionQueue::Enqueue(Plan plan) {
                   "optimising the joint keyframes of task plan " + std::to_string(made_) + " (" +
                       std::to_string(plan.actions.size()) + " actions)");
     const auto t0 = std::chrono::steady_clock::now();
-    KeyframeOptOptions keyframes = options_.keyframes;
-    keyframes.min_clearance_m = options_.task.skills.robot_clearance_m;  // the task planner's
-    auto report = OptimizeKeyframes(world_, plan, keyframes, ctx_);
+    auto report = OptimizeKeyframes(world_, plan, keyframes_, ctx_);
     t_kf_ += Since(t0);
     if (!report) {
       if (report.error().code == ErrorCode::kCancelled) return std::unexpected(report.error());
