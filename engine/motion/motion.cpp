@@ -174,7 +174,7 @@ void SetTimedFailure(const Plan& plan, const TrajectoryCheck& check, MotionFailu
 }  // namespace
 
 Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const MotionOptions& options,
-                                 int effort, std::uint64_t seed, MotionCache& cache,
+                                 const MotionRequest& request, MotionCache& cache,
                                  RunContext& ctx) {
   // Times a free path is searched again with another seed when the timed result grazes
   // something inside it (a contact narrower than the path search's step: see below).
@@ -186,8 +186,7 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
     plan.actions = original;
     auto t0 = std::chrono::steady_clock::now();
     Plan work = plan;  // keyframes may be rebranched: only a plan with motion keeps them
-    auto segments =
-        PlanGeometricMotion(world, work, options, effort, seed, cache, ctx, &out.failure);
+    auto segments = PlanGeometricMotion(world, work, options, request, cache, ctx, &out.failure);
     const double t_geo = Since(t0);
     out.t_mp_s += t_geo;
     ctx.AddTime("mp", t_geo);

@@ -1,8 +1,9 @@
-// The motion stage's options, failure record and path cache: what PlanMotion (motion.h) takes and
-// gives besides the plan. Apart from motion.h so that the stage's own parts (segments.h) use them
-// without including the front door.
+// The motion stage's options, per-attempt request, failure record and path cache: what PlanMotion
+// (motion.h) takes and gives besides the plan. Apart from motion.h so that the stage's own parts
+// (segments.h) use them without including the front door.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -50,6 +51,14 @@ struct MotionOptions {
   /// Debugging: every timed result the self-check refuses is saved here as a plan JSON
   /// (refused_N.json); empty: none (`wrap plan --dump-refused DIR`).
   std::filesystem::path dump_refused_dir;
+};
+
+/// What varies between the motion attempts on one plan (the options are fixed for a run).
+struct MotionRequest {
+  /// Effort level 0..MotionOptions::max_effort: the searches' work budgets
+  /// (MotionOptions::segment_checks and carry_edges) double per level.
+  int effort = 0;
+  std::uint64_t seed = 0;  ///< Seed of the path searches.
 };
 
 /// Why the geometric motion of a plan could not be made.

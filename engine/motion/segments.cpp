@@ -445,10 +445,11 @@ constexpr std::array<std::string_view, 8> kKindNames = {"free",    "approach", "
 std::string_view ToString(SegmentKind kind) { return kKindNames[static_cast<int>(kind)]; }
 
 Result<std::vector<GeoSegment>> PlanGeometricMotion(const TaskWorld& world, Plan& plan,
-                                                    const MotionOptions& options, int effort,
-                                                    std::uint64_t seed, MotionCache& cache,
-                                                    RunContext& ctx, MotionFailure* failure) {
-  detail::SegmentBuilder builder(world, plan, options, effort, seed, cache, ctx, failure);
+                                                    const MotionOptions& options,
+                                                    const MotionRequest& request,
+                                                    MotionCache& cache, RunContext& ctx,
+                                                    MotionFailure* failure) {
+  detail::SegmentBuilder builder(world, plan, options, request, cache, ctx, failure);
   return builder.Run();
 }
 

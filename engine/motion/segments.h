@@ -4,7 +4,6 @@
 // two-handed carries) as straight Cartesian moves. Untimed; retime.h times them.
 #pragma once
 
-#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -66,18 +65,19 @@ std::optional<SoleLoad> SoleLoadOf(const TaskWorld& world, const PlanState& stat
 /// orientation is R_WG, to its limit.
 double LoadRatio(const SoleLoad& load, const Mat3& R_WG, const Vec3& accel_W = Vec3::Zero());
 
-/// The geometric motion of `plan` at effort level `effort`. Keyframes stay, except where a straight
-/// two-handed carry or an insertion reaches the keyframe's TCP pose on another IK solution that is
-/// collision-free and clear of the other robots there: that solution replaces the robot's joints
-/// at that keyframe and the following ones where it stood still (validate the plan again). On
-/// success the segments in execution order (the plan's order; the schedule may overlap them);
+/// The geometric motion of `plan` at effort level request.effort. Keyframes stay, except where a
+/// straight two-handed carry or an insertion reaches the keyframe's TCP pose on another IK solution
+/// that is collision-free and clear of the other robots there: that solution replaces the robot's
+/// joints at that keyframe and the following ones where it stood still (validate the plan again).
+/// On success the segments in execution order (the plan's order; the schedule may overlap them);
 /// otherwise `failure` says which segment failed. `cache` keeps solved free paths between calls
-/// for the same plan. Deterministic for a given seed when no path search runs out of time.
+/// for the same plan. Deterministic for a given request.seed when no path search runs out of time.
 /// Fails with kCancelled when ctx is cancelled and kInvalidInput when the plan does not fit the
 /// world.
 Result<std::vector<GeoSegment>> PlanGeometricMotion(const TaskWorld& world, Plan& plan,
-                                                    const MotionOptions& options, int effort,
-                                                    std::uint64_t seed, MotionCache& cache,
-                                                    RunContext& ctx, MotionFailure* failure);
+                                                    const MotionOptions& options,
+                                                    const MotionRequest& request,
+                                                    MotionCache& cache, RunContext& ctx,
+                                                    MotionFailure* failure);
 
 }  // namespace wrap

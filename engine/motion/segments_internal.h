@@ -128,13 +128,14 @@ struct BuilderCheckpoint {
 // keeping the robots' joints, finger openings and the objects' state, and records the segments.
 class SegmentBuilder {
  public:
-  SegmentBuilder(const TaskWorld& world, Plan& plan, const MotionOptions& options, int effort,
-                 std::uint64_t seed, MotionCache& cache, RunContext& ctx, MotionFailure* failure)
+  SegmentBuilder(const TaskWorld& world, Plan& plan, const MotionOptions& options,
+                 const MotionRequest& request, MotionCache& cache, RunContext& ctx,
+                 MotionFailure* failure)
       : w_(world),
         plan_(plan),
         opt_(options),
-        effort_(effort),
-        seed_(seed),
+        effort_(request.effort),
+        seed_(request.seed),
         cache_(cache),
         ctx_(ctx),
         failure_(failure) {}

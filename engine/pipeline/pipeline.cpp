@@ -226,8 +226,9 @@ Result<std::optional<Plan>> MotionQueue::TryMotion() {
                 "task plan " + std::to_string(c.order + 1) + " of " + std::to_string(made_) +
                     ", effort " + std::to_string(c.effort) + " (" + std::to_string(suspensions_) +
                     " suspensions so far)");
-  auto attempt =
-      PlanMotion(world_, c.plan, motion_, c.effort, c.plan.stats.seed ^ 0x4d50ULL, c.cache, ctx_);
+  // The path searches are seeded by the task plan's seed, xor "MP" (motion planning).
+  const MotionRequest request{.effort = c.effort, .seed = c.plan.stats.seed ^ 0x4d50ULL};
+  auto attempt = PlanMotion(world_, c.plan, motion_, request, c.cache, ctx_);
   if (!attempt) return std::unexpected(attempt.error());
   t_mp_ += attempt->t_mp_s;
   t_retime_ += attempt->t_retime_s;

@@ -442,8 +442,6 @@ TEST(Motion, SameSeedSameTrajectories) {
   EXPECT_EQ(again.stats.makespan_s, first.stats.makespan_s);
 }
 
-// Paths searched at a resolution far too coarse step through obstacles; the independent check
-// inside PlanMotion refuses them, so no colliding trajectory leaves the planner.
 // A free path marked for another seed (what PlanMotion does when the timed result grazes
 // something inside it) is searched again and comes out different; the rest comes from the cache
 // and the result still passes the check.
@@ -460,7 +458,7 @@ TEST(Motion, FreePathsMarkedForAnotherSeedAreSearchedAgain) {
   MotionCache cache;
   RunContext ctx(1);
   MotionOptions options;
-  auto a = PlanMotion(*p.world, first, options, 1, 5, cache, ctx);
+  auto a = PlanMotion(*p.world, first, options, {.effort = 1, .seed = 5}, cache, ctx);
   ASSERT_TRUE(a && a->solved);
   // The searched (not straight) free paths, marked; their cached paths forgotten.
   std::vector<std::vector<std::vector<JointVector>>> before(cache.free_paths.size());
@@ -475,7 +473,7 @@ TEST(Motion, FreePathsMarkedForAnotherSeedAreSearchedAgain) {
   }
   ASSERT_GT(marked, 0);
   Plan again = strip(*p.plan);
-  auto b = PlanMotion(*p.world, again, options, 1, 5, cache, ctx);
+  auto b = PlanMotion(*p.world, again, options, {.effort = 1, .seed = 5}, cache, ctx);
   ASSERT_TRUE(b && b->solved) << (b ? b->failure.message : b.error().message);
   int differ = 0;
   for (size_t k = 0; k < before.size() && k < cache.free_paths.size(); ++k) {
@@ -489,6 +487,8 @@ TEST(Motion, FreePathsMarkedForAnotherSeedAreSearchedAgain) {
   EXPECT_TRUE(check->valid);
 }
 
+// Paths searched at a resolution far too coarse step through obstacles; the independent check
+// inside PlanMotion refuses them, so no colliding trajectory leaves the planner.
 TEST(Motion, TheSelfCheckRefusesTrajectoriesThatCollide) {
   const Planned& p = PlanOnce("half_stool");
   ASSERT_TRUE(p.error.empty()) << p.error;
@@ -498,7 +498,7 @@ TEST(Motion, TheSelfCheckRefusesTrajectoriesThatCollide) {
   Plan unchecked = *p.plan;
   MotionCache cache;
   RunContext ctx(1);
-  auto attempt = PlanMotion(*p.world, unchecked, coarse, 0, 3, cache, ctx);
+  auto attempt = PlanMotion(*p.world, unchecked, coarse, {.effort = 0, .seed = 3}, cache, ctx);
   ASSERT_TRUE(attempt.has_value()) << attempt.error().message;
   ASSERT_TRUE(attempt->solved) << attempt->failure.message;
   auto check = CheckTrajectories(*p.world, unchecked, TrajectoryCheckOptions{});
@@ -507,7 +507,7 @@ TEST(Motion, TheSelfCheckRefusesTrajectoriesThatCollide) {
   coarse.self_check = true;
   Plan checked = *p.plan;
   MotionCache cache2;
-  attempt = PlanMotion(*p.world, checked, coarse, 0, 3, cache2, ctx);
+  attempt = PlanMotion(*p.world, checked, coarse, {.effort = 0, .seed = 3}, cache2, ctx);
   ASSERT_TRUE(attempt.has_value()) << attempt.error().message;
   EXPECT_FALSE(attempt->solved);
   EXPECT_EQ(attempt->failure.segment, "timed");
@@ -532,7 +532,7 @@ TEST(Motion, AFailureCarriesTheCellWhereItHappened) {
   for (PlanAction& a : plan.actions) a.start_s = a.end_s = -1.0;
   MotionCache cache;
   RunContext ctx(1);
-  auto attempt = PlanMotion(*p.world, plan, options, 0, 3, cache, ctx);
+  auto attempt = PlanMotion(*p.world, plan, options, {.effort = 0, .seed = 3}, cache, ctx);
   ASSERT_TRUE(attempt.has_value()) << attempt.error().message;
   ASSERT_FALSE(attempt->solved);
   const MotionFailure& f = attempt->failure;
@@ -718,7 +718,7 @@ TEST_F(Handmade, APlacementWhereTheObjectAlreadyIsStillMovesIt) {
   for (PlanAction& a : plan.actions) a.start_s = a.end_s = -1.0;
   MotionCache cache;
   RunContext ctx(1);
-  auto attempt = PlanMotion(w, plan, MotionOptions{}, 0, 1, cache, ctx);
+  auto attempt = PlanMotion(w, plan, MotionOptions{}, {.effort = 0, .seed = 1}, cache, ctx);
   ASSERT_TRUE(attempt) << attempt.error().message;
   ASSERT_TRUE(attempt->solved) << attempt->failure.message;
   bool lift = false, descend = false;
