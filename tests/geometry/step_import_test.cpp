@@ -1,8 +1,8 @@
 // Tests of STEP import: files built in the test with OpenCASCADE itself (WriteStep: boxes, a
 // cylinder, a sphere, a peg-and-hole assembly with four instances of one leg, millimetres and
 // inches), imported back and checked for names, counts, poses, volumes, colours and closedness;
-// bad files; the tessellation cache; LoadMeshFile. Skipped in a build without OpenCASCADE
-// (WRAP_WITH_OCCT=OFF), where StepUnavailable checks the message instead.
+// bad files; the tessellation cache; LoadMeshFile. Those exist only in a build with OpenCASCADE
+// (WRAP_WITH_OCCT); a build without it has StepUnavailableWithoutOpenCascade instead.
 #include "geometry/step_import.h"
 
 #include <gtest/gtest.h>
@@ -25,12 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Kind = StepPrimitive::Kind;
-
-constexpr double kPoseTol = 1e-6;     // [m]
-constexpr double kVolumeRel = 0.005;  // 0.5%
-
-#define SKIP_WITHOUT_OCCT() \
-  if (!StepImportAvailable()) GTEST_SKIP() << "built without OpenCASCADE (WRAP_WITH_OCCT=OFF)"
 
 class StepImportTest : public ::testing::Test {
  protected:
@@ -64,6 +58,22 @@ class StepImportTest : public ::testing::Test {
   fs::path dir_;
 };
 
+void ExpectError(const Result<StepAssembly>& a, ErrorCode code, const fs::path& file,
+                 const std::vector<std::string>& phrases) {
+  ASSERT_FALSE(a.has_value()) << "expected an error for " << file;
+  EXPECT_EQ(a.error().code, code) << a.error().message;
+  EXPECT_NE(a.error().message.find(file.string()), std::string::npos) << a.error().message;
+  for (const std::string& p : phrases) {
+    EXPECT_NE(a.error().message.find(p), std::string::npos)
+        << "'" << p << "' in " << a.error().message;
+  }
+}
+
+// Files written by OpenCASCADE and imported back: a build with it only (WRAP_WITH_OCCT).
+#if WRAP_TEST_WITH_OCCT
+constexpr double kPoseTol = 1e-6;     // [m]
+constexpr double kVolumeRel = 0.005;  // 0.5%
+
 StepPrimitive Box(const Vec3& lo, const Vec3& size) {
   return {.kind = Kind::kBox, .origin = lo, .size = size};
 }
@@ -80,17 +90,6 @@ StepDocumentSpec OneProduct(const std::string& name, std::vector<StepPrimitive> 
 }
 
 double Volume(const TriangleMesh& mesh) { return ComputeMassProperties(mesh).volume_m3; }
-
-void ExpectError(const Result<StepAssembly>& a, ErrorCode code, const fs::path& file,
-                 const std::vector<std::string>& phrases) {
-  ASSERT_FALSE(a.has_value()) << "expected an error for " << file;
-  EXPECT_EQ(a.error().code, code) << a.error().message;
-  EXPECT_NE(a.error().message.find(file.string()), std::string::npos) << a.error().message;
-  for (const std::string& p : phrases) {
-    EXPECT_NE(a.error().message.find(p), std::string::npos)
-        << "'" << p << "' in " << a.error().message;
-  }
-}
 
 // The peg-and-hole assembly: a plate with four round blind pockets from below and four
 // instances of one leg (a body with a peg on top), the plate coloured, rotated legs included.
@@ -174,7 +173,6 @@ void ExpectPegAndHole(const StepAssembly& a, const PegAndHole& d) {
 }
 
 TEST_F(StepImportTest, BoxInMillimetres) {
-  SKIP_WITHOUT_OCCT();
   StepDocumentSpec spec =
       OneProduct("block", {Box(Vec3(-0.02, -0.015, 0), Vec3(0.04, 0.03, 0.02))});
   spec.products[0].color = std::array<double, 4>{0.25, 0.5, 0.75, 1.0};
@@ -201,7 +199,6 @@ TEST_F(StepImportTest, BoxInMillimetres) {
 }
 
 TEST_F(StepImportTest, CylinderVolumeAndDeflection) {
-  SKIP_WITHOUT_OCCT();
   const double r = 0.025, h = 0.05;  // a 5 cm part
   const fs::path file = WriteSpec(OneProduct("can", {Cylinder(Vec3::Zero(), r, h)}), "can.stp");
   auto a = ImportStep(file);
@@ -227,7 +224,6 @@ TEST_F(StepImportTest, CylinderVolumeAndDeflection) {
 }
 
 TEST_F(StepImportTest, SphereOfFiveCentimetresStaysWithinATenthOfAMillimetre) {
-  SKIP_WITHOUT_OCCT();
   const double r = 0.025;
   const fs::path file =
       WriteSpec(OneProduct("ball", {{.kind = Kind::kSphere, .origin = Vec3(0, 0, r), .radius = r}}),
@@ -252,7 +248,6 @@ TEST_F(StepImportTest, SphereOfFiveCentimetresStaysWithinATenthOfAMillimetre) {
 }
 
 TEST_F(StepImportTest, PegAndHoleAssemblyInMillimetres) {
-  SKIP_WITHOUT_OCCT();
   const PegAndHole design;
   const fs::path file = WriteSpec(design.Spec("MM"), "peg_and_hole.step");
   auto a = ImportStep(file);
@@ -266,7 +261,6 @@ TEST_F(StepImportTest, PegAndHoleAssemblyInMillimetres) {
 }
 
 TEST_F(StepImportTest, PegAndHoleAssemblyInInchesComesInMetres) {
-  SKIP_WITHOUT_OCCT();
   const PegAndHole design;
   const fs::path inches = WriteSpec(design.Spec("INCH"), "peg_and_hole_in.step");
   const std::string text = Text(inches);
@@ -280,7 +274,6 @@ TEST_F(StepImportTest, PegAndHoleAssemblyInInchesComesInMetres) {
 }
 
 TEST_F(StepImportTest, MultiSolidProductGivesOneSolidEach) {
-  SKIP_WITHOUT_OCCT();
   StepDocumentSpec spec;
   spec.products.push_back({"pair",
                            {{Box(Vec3(0, 0, 0), Vec3(0.01, 0.01, 0.01))},
@@ -303,7 +296,6 @@ TEST_F(StepImportTest, MultiSolidProductGivesOneSolidEach) {
 }
 
 TEST_F(StepImportTest, DeterministicAcrossImports) {
-  SKIP_WITHOUT_OCCT();
   const fs::path file = WriteSpec(PegAndHole().Spec("MM"), "peg_and_hole.step");
   auto a = ImportStep(file);
   auto b = ImportStep(file);
@@ -322,7 +314,6 @@ TEST_F(StepImportTest, DeterministicAcrossImports) {
 }
 
 TEST_F(StepImportTest, ConcurrentImportsAgree) {
-  SKIP_WITHOUT_OCCT();
   const fs::path file = WriteSpec(PegAndHole().Spec("MM"), "peg_and_hole.step");
   std::vector<Result<StepAssembly>> results(3, Fail(ErrorCode::kInternal, "not run"));
   std::vector<std::thread> threads;
@@ -333,6 +324,7 @@ TEST_F(StepImportTest, ConcurrentImportsAgree) {
     EXPECT_EQ(r->triangles(), results[0]->triangles());
   }
 }
+#endif  // WRAP_TEST_WITH_OCCT
 
 // ---- Bad input --------------------------------------------------------------------------------
 
@@ -348,8 +340,8 @@ TEST_F(StepImportTest, NotAStepFile) {
   ExpectError(ImportStep(dir_), ErrorCode::kIo, dir_, {"not a regular file"});
 }
 
+#if WRAP_TEST_WITH_OCCT
 TEST_F(StepImportTest, TruncatedFile) {
-  SKIP_WITHOUT_OCCT();
   const std::string text = Text(WriteSpec(PegAndHole().Spec("MM"), "whole.step"));
   for (const double keep : {0.1, 0.5, 0.97}) {
     const fs::path cut =
@@ -364,7 +356,6 @@ TEST_F(StepImportTest, TruncatedFile) {
 }
 
 TEST_F(StepImportTest, FileWithoutSolids) {
-  SKIP_WITHOUT_OCCT();
   const fs::path points = WriteText("points.step",
                                     "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\n"
                                     "FILE_NAME('p','',(''),(''),'','','');\n"
@@ -378,7 +369,6 @@ TEST_F(StepImportTest, FileWithoutSolids) {
 }
 
 TEST_F(StepImportTest, SolidThatDoesNotMeshClosed) {
-  SKIP_WITHOUT_OCCT();
   std::string text =
       Text(WriteSpec(OneProduct("box", {Box(Vec3::Zero(), Vec3(0.01, 0.02, 0.03))}), "box.step"));
   // Drop one face from the box's closed shell: an open "solid".
@@ -392,7 +382,6 @@ TEST_F(StepImportTest, SolidThatDoesNotMeshClosed) {
 }
 
 TEST_F(StepImportTest, OpenSurfaceModelIsSkippedWithAWarning) {
-  SKIP_WITHOUT_OCCT();
   std::string text = Text(WriteSpec(PegAndHole().Spec("MM"), "peg_and_hole.step"));
   // The plate (the first solid) as a surface model of an open shell: one face dropped.
   const std::regex brep(R"((#\d+) = ADVANCED_BREP_SHAPE_REPRESENTATION)");
@@ -423,7 +412,6 @@ TEST_F(StepImportTest, OpenSurfaceModelIsSkippedWithAWarning) {
 }
 
 TEST_F(StepImportTest, FileWithoutLengthUnit) {
-  SKIP_WITHOUT_OCCT();
   std::string text =
       Text(WriteSpec(OneProduct("box", {Box(Vec3::Zero(), Vec3(0.01, 0.01, 0.01))}), "box.step"));
   const std::string unit = "LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.)";
@@ -438,26 +426,25 @@ TEST_F(StepImportTest, FileWithoutLengthUnit) {
 TEST_F(StepImportTest, DeflectionsOutOfRange) {
   const fs::path file = WriteText("x.step", "ISO-10303-21;\nEND-ISO-10303-21;\n");
   ExpectError(ImportStep(file, {.linear_deflection_m = 0.0}), ErrorCode::kInvalidInput, file,
-              StepImportAvailable() ? std::vector<std::string>{"linear deflection"}
-                                    : std::vector<std::string>{});
-  if (!StepImportAvailable()) return;
+              {"linear deflection"});
   ExpectError(ImportStep(file, {.angular_deflection_rad = 3.0}), ErrorCode::kInvalidInput, file,
               {"angular deflection"});
 }
-
+#else
+// A build without OpenCASCADE refuses STEP files, saying why.
 TEST_F(StepImportTest, StepUnavailableWithoutOpenCascade) {
-  if (StepImportAvailable()) GTEST_SKIP() << "built with OpenCASCADE";
   const fs::path file = WriteText("x.step", "ISO-10303-21;\nEND-ISO-10303-21;\n");
   ExpectError(ImportStep(file), ErrorCode::kInvalidInput, file, {"STEP is unavailable"});
   auto mesh = LoadMeshFile(file);
   ASSERT_FALSE(mesh.has_value());
   EXPECT_NE(mesh.error().message.find("STEP is unavailable"), std::string::npos);
 }
+#endif  // WRAP_TEST_WITH_OCCT
 
 // ---- The cache and LoadMeshFile ---------------------------------------------------------------
 
+#if WRAP_TEST_WITH_OCCT
 TEST_F(StepImportTest, CacheServesAReopenWithoutRemeshing) {
-  SKIP_WITHOUT_OCCT();
   const fs::path file = WriteSpec(PegAndHole().Spec("MM"), "peg_and_hole.step");
   const StepLoadOptions options{.cache_dir = dir_ / ".wrap-cache" / "step"};
   auto first = LoadStep(file, options);
@@ -498,7 +485,6 @@ TEST_F(StepImportTest, CacheServesAReopenWithoutRemeshing) {
 }
 
 TEST_F(StepImportTest, DamagedOrStaleCacheIsReplaced) {
-  SKIP_WITHOUT_OCCT();
   const fs::path file = WriteSpec(PegAndHole().Spec("MM"), "peg_and_hole.step");
   const StepLoadOptions options{.cache_dir = dir_ / "cache"};
   auto first = LoadStep(file, options);
@@ -524,7 +510,6 @@ TEST_F(StepImportTest, DamagedOrStaleCacheIsReplaced) {
 }
 
 TEST_F(StepImportTest, UnwritableCacheStillImports) {
-  SKIP_WITHOUT_OCCT();
   const fs::path file =
       WriteSpec(OneProduct("box", {Box(Vec3::Zero(), Vec3(0.01, 0.01, 0.01))}), "box.step");
   const fs::path blocked = WriteText("not_a_folder", "x");  // a file where the folder would be
@@ -535,7 +520,6 @@ TEST_F(StepImportTest, UnwritableCacheStillImports) {
 }
 
 TEST_F(StepImportTest, LoadMeshFilePicksASolidOrTheWholeFile) {
-  SKIP_WITHOUT_OCCT();
   const PegAndHole d;
   const fs::path file = WriteSpec(d.Spec("MM"), "peg_and_hole.step");
   auto leg = LoadMeshFile(file, {.solid = "leg"});
@@ -557,6 +541,13 @@ TEST_F(StepImportTest, LoadMeshFilePicksASolidOrTheWholeFile) {
   auto refused = LoadMeshFile(stl, {.solid = "leg"});
   ASSERT_FALSE(refused.has_value());
   EXPECT_NE(refused.error().message.find("not a STEP file"), std::string::npos);
+}
+#endif  // WRAP_TEST_WITH_OCCT
+
+// The tests' view of the build (WRAP_TEST_WITH_OCCT, from the option WRAP_WITH_OCCT) is the
+// library's.
+TEST(StepFiles, ImportIsAvailableExactlyInABuildWithOpenCascade) {
+  EXPECT_EQ(StepImportAvailable(), WRAP_TEST_WITH_OCCT != 0);
 }
 
 TEST(StepFiles, LooksLikeStepByNameOrHeader) {

@@ -1,7 +1,7 @@
 // The GUI as a process under Xvfb: `wrap PROJECT --screenshot` (with --run-plan and --at) and a
 // scripted flow that builds a project from meshes, draws its DAG, plans and saves it. Screenshots
 // are checked by pixel statistics per region of the fixed layout (panels present, scene drawn),
-// not against golden images: fonts and llvmpipe versions move pixels. Skipped without xvfb-run.
+// not against golden images: fonts and llvmpipe versions move pixels. Needs xvfb-run.
 #include <gtest/gtest.h>
 
 #include <cmath>

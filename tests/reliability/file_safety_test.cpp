@@ -6,6 +6,7 @@
 // saves from a child process that has dropped to the user 'nobody'. The parent-is-a-file,
 // disk-full (a character device like /dev/full) and file-size-limit (RLIMIT_FSIZE, EFBIG) cases
 // cover the other ways a write fails.
+#include <fcntl.h>
 #include <grp.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -85,15 +86,26 @@ class FileSizeLimit {
   bool ok_ = false;
 };
 
-/// A character device that behaves like /dev/full (writes fail with ENOSPC) at a path of our own
-/// when we may create one (root), else /dev/full itself (other users cannot replace it).
-fs::path DiskFullDevice(const fs::path& dir) {
-  if (::geteuid() == 0) {
-    const fs::path own = dir / "full";
-    if (::mknod(own.c_str(), S_IFCHR | 0666, makedev(1, 7)) == 0) return own;
-    return {};
+/// The system's character device `name` (/dev/full: writes fail with ENOSPC; /dev/null: writes
+/// vanish; major 1, `minor`) at dir/name: a node of our own where we may make one (root with
+/// CAP_MKNOD, on a file system that allows devices), else a symbolic link to the system's device.
+/// A write follows either to the device. A save that replaced the file (renaming its temporary
+/// file over it) would replace our node or link, never the system's device, and leave a regular
+/// file at dir/name.
+fs::path CharDevice(const fs::path& dir, const std::string& name, unsigned minor) {
+  const fs::path own = dir / name;
+  if (::mknod(own.c_str(), S_IFCHR | 0666, makedev(1, minor)) == 0) {
+    const int fd = ::open(own.c_str(), O_WRONLY);
+    if (fd >= 0) {
+      ::close(fd);
+      return own;
+    }
+    fs::remove(own);  // a file system mounted nodev: the node cannot be opened
   }
-  return "/dev/full";
+  std::error_code ec;
+  fs::create_symlink(fs::path("/dev") / name, own, ec);
+  EXPECT_FALSE(ec) << "cannot link " << own << " to /dev/" << name << ": " << ec.message();
+  return own;
 }
 
 TEST(FileSafety, SaveIntoAFolderThatIsARegularFile) {
@@ -172,8 +184,7 @@ TEST(FileSafety, SaveStoppedByAFileSizeLimit) {
 // used to turn /dev/null into a regular file); a full disk is an error that names the path.
 TEST(FileSafety, DiskFullDeviceIsWrittenInPlaceAndFails) {
   TempDir dir("disk_full");
-  const fs::path full = DiskFullDevice(dir.path);
-  if (full.empty()) GTEST_SKIP() << "cannot create a device node here";
+  const fs::path full = CharDevice(dir.path, "full", 7);
   ASSERT_TRUE(fs::is_character_file(full));
   auto saved = SaveProject(Edited(), full);
   ASSERT_FALSE(saved.has_value());
@@ -182,13 +193,11 @@ TEST(FileSafety, DiskFullDeviceIsWrittenInPlaceAndFails) {
   EXPECT_NE(saved.error().message.find("No space left"), std::string::npos)
       << saved.error().message;
   EXPECT_TRUE(fs::is_character_file(full)) << full << " was replaced";
-  if (::geteuid() == 0) {
-    // And a null device takes the bytes and stays a device.
-    const fs::path null = dir.path / "null";
-    ASSERT_EQ(::mknod(null.c_str(), S_IFCHR | 0666, makedev(1, 3)), 0);
-    EXPECT_TRUE(WriteFileAtomic(null, "bytes").has_value());
-    EXPECT_TRUE(fs::is_character_file(null)) << null << " was replaced";
-  }
+  // And a null device takes the bytes and stays a device.
+  const fs::path null = CharDevice(dir.path, "null", 3);
+  ASSERT_TRUE(fs::is_character_file(null));
+  EXPECT_TRUE(WriteFileAtomic(null, "bytes").has_value());
+  EXPECT_TRUE(fs::is_character_file(null)) << null << " was replaced";
 }
 
 TEST(FileSafety, SaveOverADirectoryFails) {
@@ -229,13 +238,11 @@ TEST(FileSafety, CommandResultsKeepThePreviousFile) {
   EXPECT_NE(r.err.find("project.json"), std::string::npos) << r.err;
   ExpectIntact(prev, dir.path);
 
-  const fs::path full = DiskFullDevice(dir.path);
-  if (!full.empty()) {
-    r = Wrap({"plan", project, "--task-only", "-o", full.string()});
-    EXPECT_EQ(r.code, 2) << r.err;
-    EXPECT_NE(r.err.find("No space left"), std::string::npos) << r.err;
-    EXPECT_TRUE(fs::is_character_file(full));
-  }
+  const fs::path full = CharDevice(dir.path, "full", 7);
+  r = Wrap({"plan", project, "--task-only", "-o", full.string()});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("No space left"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_character_file(full)) << full << " was replaced";
 }
 
 }  // namespace

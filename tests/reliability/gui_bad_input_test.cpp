@@ -2,7 +2,7 @@
 // JSON, not a project, a newer version) exits 2 naming the file and the field, with no screenshot
 // written. A readable project with a broken mesh or URDF opens (the GUI is where it gets fixed;
 // its diagnostics are shown there): it must not crash. Runs the real executable under Xvfb
-// (skipped without xvfb-run), so it is built only with the UI.
+// (it needs xvfb-run), so it is built only with the UI.
 #include <sys/wait.h>
 
 #include <cstdlib>

@@ -1,5 +1,5 @@
 // The renderer in this process (EGL): frames follow the scene state, text strips, and the rule
-// of one GL platform library per process. Skipped where EGL cannot make a context.
+// of one GL platform library per process. Fails where EGL cannot make a context.
 #include <gtest/gtest.h>
 
 #include <filesystem>
