@@ -10,7 +10,6 @@
 #include "task/search.h"
 
 namespace wrap {
-
 bool TaskSearch::Recall(CheapAnswer& answer) {
   // Counted once per milestone: the tally counts distinct questions, not how often the search
   // met them.
@@ -35,33 +34,39 @@ void TaskSearch::Remember(std::uint64_t key, bool ok) {
   }
 }
 
+bool TaskSearch::GripperFitsAtRest(int robot, int node, int loc, int grasp, bool placing,
+                                   const CheckSubject& about) {
+  const Iso3 target = solver_.GraspTarget(tables_.location(loc).X_WA, grasp);
+  const std::string& name = world_.tree->nodes[node].name;
+  const std::string grasp_index = std::to_string(tables_.grasp(grasp).index);
+  if (!solver_.InReach(robot, target)) {
+    tally_.Add(Gate::kReach,
+               "'" + world_.robots[robot].name + "' cannot reach " +
+                   (placing ? "to set '" + name + "' down there"
+                            : "grasp " + grasp_index + " of '" + name + "' where it rests"),
+               about);
+    return false;
+  }
+  if (!solver_.ClearOfTable(robot, target, solver_.GraspOpening(grasp))) {
+    CheckSubject hit = about;
+    hit.hit_table = true;
+    tally_.Add(Gate::kGripperTable,
+               placing ? "setting '" + name + "' down with grasp " + grasp_index +
+                             " puts the gripper into the table"
+                       : "grasp " + grasp_index + " of '" + name +
+                             "' puts the gripper into the table where it rests",
+               hit);
+    return false;
+  }
+  return true;
+}
+
 bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
   std::uint64_t key = HashMix(HashMix(HashMix(HashMix(101, robot), node), loc), grasp);
   if (int* index = cheap_.find(key)) return Recall(cheap_answers_[*index]);
   const Iso3 X_WA = tables_.location(loc).X_WA;
-  const Iso3 target = solver_.GraspTarget(X_WA, grasp);
-  bool ok = solver_.InReach(robot, target);
-  CheckSubject about;
-  about.object = node;
-  about.robot = robot;
-  about.grasp = grasp;
-  about.loc = loc;
-  if (!ok)
-    tally_.Add(Gate::kReach,
-               "'" + world_.robots[robot].name + "' cannot reach grasp " +
-                   std::to_string(tables_.grasp(grasp).index) + " of '" +
-                   world_.tree->nodes[node].name + "' where it rests",
-               about);
-  if (ok && !solver_.ClearOfTable(robot, target, solver_.GraspOpening(grasp))) {
-    ok = false;
-    CheckSubject hit = about;
-    hit.hit_table = true;
-    tally_.Add(Gate::kGripperTable,
-               "grasp " + std::to_string(tables_.grasp(grasp).index) + " of '" +
-                   world_.tree->nodes[node].name +
-                   "' puts the gripper into the table where it rests",
-               hit);
-  }
+  const CheckSubject about{.object = node, .robot = robot, .grasp = grasp, .loc = loc};
+  bool ok = GripperFitsAtRest(robot, node, loc, grasp, /*placing=*/false, about);
   if (ok) {
     std::string why;
     ok = solver_.SoloReach(robot, {{node, X_WA, true}}, grasp, &why);
@@ -145,27 +150,8 @@ bool TaskSearch::CheapPlace(int robot, int node, int loc, int grasp) {
   std::uint64_t key = HashMix(HashMix(HashMix(HashMix(102, robot), node), loc), grasp);
   if (int* index = cheap_.find(key)) return Recall(cheap_answers_[*index]);
   const Iso3 X_WA = tables_.location(loc).X_WA;
-  const Iso3 target = solver_.GraspTarget(X_WA, grasp);
-  bool ok = solver_.InReach(robot, target);
-  CheckSubject about;
-  about.object = node;
-  about.robot = robot;
-  about.grasp = grasp;
-  about.loc = loc;
-  if (!ok)
-    tally_.Add(Gate::kReach,
-               "'" + world_.robots[robot].name + "' cannot reach to set '" +
-                   world_.tree->nodes[node].name + "' down there",
-               about);
-  if (ok && !solver_.ClearOfTable(robot, target, solver_.GraspOpening(grasp))) {
-    ok = false;
-    CheckSubject hit = about;
-    hit.hit_table = true;
-    tally_.Add(Gate::kGripperTable,
-               "setting '" + world_.tree->nodes[node].name + "' down with grasp " +
-                   std::to_string(tables_.grasp(grasp).index) + " puts the gripper into the table",
-               hit);
-  }
+  const CheckSubject about{.object = node, .robot = robot, .grasp = grasp, .loc = loc};
+  bool ok = GripperFitsAtRest(robot, node, loc, grasp, /*placing=*/true, about);
   if (ok && !HomesClear(node, loc)) {
     ok = false;
     CheckSubject in_way = about;
@@ -215,31 +201,26 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
     return a;
   };
   const int r0 = mh.empty() ? -1 : mh.front().first, g0 = mh.empty() ? -1 : mh.front().second;
-  // Context-free: no gripper may touch the other input at the mating pose.
+  // Context-free: no gripper may touch the other input at the mating pose. Each holder of
+  // `held`, in order, against `other`; the first that touches fails the check.
   {
     const Iso3 X = b_rests ? tables_.location(s.loc[m.base]).X_WA : Iso3::Identity();
-    for (const auto& [r, g] : mh) {
-      if (ok && !solver_.GripperClear(r, g, X, m.base, X)) {
-        ok = false;
-        tally_.Add(Gate::kCollision,
-                   "the gripper of '" + world_.robots[r].name + "' at grasp " +
-                       std::to_string(tables_.grasp(g).index) + " of '" +
-                       world_.tree->nodes[m.moved].name + "' hits '" +
-                       world_.tree->nodes[m.base].name + "' when mated",
-                   about(r, g, m.moved, m.base));
+    auto grippers_clear = [&](const std::vector<std::pair<int, int>>& holders, int held,
+                              int other) {
+      for (const auto& [r, g] : holders) {
+        if (ok && !solver_.GripperClear(r, g, X, other, X)) {
+          ok = false;
+          tally_.Add(Gate::kCollision,
+                     "the gripper of '" + world_.robots[r].name + "' at grasp " +
+                         std::to_string(tables_.grasp(g).index) + " of '" +
+                         world_.tree->nodes[held].name + "' hits '" +
+                         world_.tree->nodes[other].name + "' when mated",
+                     about(r, g, held, other));
+        }
       }
-    }
-    for (const auto& [r, g] : bh) {
-      if (ok && !solver_.GripperClear(r, g, X, m.moved, X)) {
-        ok = false;
-        tally_.Add(Gate::kCollision,
-                   "the gripper of '" + world_.robots[r].name + "' at grasp " +
-                       std::to_string(tables_.grasp(g).index) + " of '" +
-                       world_.tree->nodes[m.base].name + "' hits '" +
-                       world_.tree->nodes[m.moved].name + "' when mated",
-                   about(r, g, m.base, m.moved));
-      }
-    }
+    };
+    grippers_clear(mh, m.moved, m.base);
+    grippers_clear(bh, m.base, m.moved);
   }
   if (!ok) {
   } else if (b_rests) {

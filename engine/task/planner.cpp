@@ -1,3 +1,7 @@
+// The task planner's front door (planner.h): PlanTask checks the insertion paths and its options,
+// builds the search's rig and fills the milestones in the DAG's order (with backtracking), then
+// improves the plan while time is left; UnpickableAtStart asks the same rig which parts no robot
+// can take where they start.
 #include "task/planner.h"
 
 #include <algorithm>
@@ -6,6 +10,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <set>
 
 #include "mating/check.h"
@@ -184,7 +190,8 @@ Result<void> CheckOptions(const TaskPlannerOptions& options) {
     return Fail(ErrorCode::kInvalidInput, "planner: --force-scale must be finite and >= 0");
   }
   if (options.max_effort < 0 || options.max_effort > 2 || options.max_holders < 1 ||
-      options.max_nodes < 100 || !(options.skills.robot_clearance_m >= 0.0) || options.memory_limit_mb < 1) {
+      options.max_nodes < 100 || !(options.skills.robot_clearance_m >= 0.0) ||
+      options.memory_limit_mb < 1) {
     return Fail(ErrorCode::kInvalidInput, "planner: options out of range");
   }
   return {};
@@ -211,6 +218,33 @@ void StartTask(const Project& project, const TaskWorld& world, TaskTables& table
   for (const TaskRobot& r : world.robots) c0.q.push_back(r.home);
   plan.initial.q = c0.q;
   for (int p = 0; p < world.num_parts; ++p) plan.initial.objects.push_back({p, c0.X_WA[p], true});
+}
+
+// What the task search runs on, for one project: its world, the tables the search fills, the
+// keyframe solver on the world's cell and the solver's counters. The solver holds references to
+// the others, so a rig does not move (BuildRig makes it on the heap).
+struct SearchRig {
+  TaskWorld world;
+  TaskTables tables;
+  TaskCounters counters;
+  std::optional<KeyframeSolver> solver;
+};
+
+// The rig of `project`. The solver's cell checks the objects against the table as well
+// (CellOptions::objects_touch_table = false).
+Result<std::unique_ptr<SearchRig>> BuildRig(const Project& project, const ProjectCheck& check,
+                                            const Preprocessed& pre,
+                                            const TaskPlannerOptions& options) {
+  auto world = BuildTaskWorld(project, check, pre, options.project_file);
+  if (!world) return std::unexpected(world.error());
+  auto rig = std::make_unique<SearchRig>();
+  rig->world = std::move(*world);
+  CellOptions cell_options;
+  cell_options.objects_touch_table = false;
+  auto cell = Cell::Build(rig->world.cell_def, cell_options);
+  if (!cell) return Fail(ErrorCode::kInvalidInput, "planner: " + cell.error().message);
+  rig->solver.emplace(rig->world, rig->tables, options, std::move(*cell), rig->counters);
+  return rig;
 }
 
 // Where the milestone loop ended.
@@ -368,17 +402,11 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   if (auto free = CheckInsertionPaths(project, check); !free) return std::unexpected(free.error());
   const auto start = Clock::now();
   if (auto valid = CheckOptions(options); !valid) return std::unexpected(valid.error());
-  auto world_or = BuildTaskWorld(project, check, pre, options.project_file);
-  if (!world_or) return std::unexpected(world_or.error());
-  const TaskWorld& world = *world_or;
-  CellOptions cell_options;
-  cell_options.objects_touch_table = false;
-  auto cell = Cell::Build(world.cell_def, cell_options);
-  if (!cell) return Fail(ErrorCode::kInvalidInput, "planner: " + cell.error().message);
-
-  TaskTables tables;
-  TaskCounters counters;
-  KeyframeSolver solver(world, tables, options, std::move(*cell), counters);
+  auto rig = BuildRig(project, check, pre, options);
+  if (!rig) return std::unexpected(rig.error());
+  const TaskWorld& world = (*rig)->world;
+  TaskTables& tables = (*rig)->tables;
+  KeyframeSolver& solver = *(*rig)->solver;
   solver.set_log(&ctx);
   const std::uint64_t seed = ctx.rng()();
   const bool widen = options.widen.value_or(project.planner.widen_grasps);
@@ -407,7 +435,7 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   if (ctx.cancelled()) return Fail(ErrorCode::kCancelled, "planner: cancelled");
 
   PlanStats& st = plan.stats;
-  CountSearch(project, pre, options, search, counters, ctx, st);
+  CountSearch(project, pre, options, search, (*rig)->counters, ctx, st);
   st.milestones = K;
   st.backtracks = run.backtracks;
   st.t_init_s = t_first;
@@ -438,18 +466,12 @@ Result<std::vector<UnpickablePart>> UnpickableAtStart(const Project& project,
                                                       const Preprocessed& pre,
                                                       const TaskPlannerOptions& options,
                                                       int max_grasps) {
-  auto world_or = BuildTaskWorld(project, check, pre, options.project_file);
-  if (!world_or) return std::unexpected(world_or.error());
-  const TaskWorld& world = *world_or;
-  CellOptions cell_options;
-  cell_options.objects_touch_table = false;
-  auto cell = Cell::Build(world.cell_def, cell_options);
-  if (!cell) return Fail(ErrorCode::kInvalidInput, "planner: " + cell.error().message);
-  TaskTables tables;
-  TaskCounters counters;
-  KeyframeSolver solver(world, tables, options, std::move(*cell), counters);
+  auto rig = BuildRig(project, check, pre, options);
+  if (!rig) return std::unexpected(rig.error());
+  const TaskWorld& world = (*rig)->world;
+  TaskTables& tables = (*rig)->tables;
   RunContext ctx;
-  TaskSearch search(world, tables, solver, options, ctx, 0, false);
+  TaskSearch search(world, tables, *(*rig)->solver, options, ctx, 0, false);
   const int grasps = max_grasps > 0 ? max_grasps : std::numeric_limits<int>::max();
   std::vector<int> locations(world.num_parts);
   for (int p = 0; p < world.num_parts; ++p) {

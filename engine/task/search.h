@@ -271,9 +271,17 @@ class TaskSearch {
   FailureScene SceneOf(const SymState& s, const ContState& c) const;
   /// The failure record's case for one tallied gate.
   FailureCase Case(Gate gate, const FailureScene& start) const;
+  /// The cheap checks of `robot` picking `node` resting at location `loc` at grasp `grasp`:
+  /// reach, the gripper clear of the table, IK, carrying it right after the lift (cached).
   bool CheapPick(int robot, int node, int loc, int grasp);
-
+  /// The cheap checks of `robot` setting `node` down at location `loc` at grasp `grasp`: reach,
+  /// the gripper clear of the table, the homes clear, IK, the object resting there (cached).
   bool CheapPlace(int robot, int node, int loc, int grasp);
+  /// The first two checks of CheapPick and CheapPlace: the TCP at `grasp` of `node` resting at
+  /// `loc` within the reach of `robot`, then its gripper clear of the table. A failure is tallied
+  /// about `about`, in the words of a pick or (`placing`) of a set-down.
+  bool GripperFitsAtRest(int robot, int node, int loc, int grasp, bool placing,
+                         const CheckSubject& about);
   bool CheapAssemble(const SymState& s, const Milestone& m);
   /// `node` resting at location `loc` leaves every robot room at home (cached).
   bool HomesClear(int node, int loc);

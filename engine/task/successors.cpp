@@ -8,6 +8,19 @@
 #include "task/search.h"
 
 namespace wrap {
+namespace {
+
+// An action of `type` by `robot` (-1: none) on `node`; the caller adds its grasp, receiver or
+// location.
+TaskAction ActionOn(ActionType type, int robot, int node) {
+  TaskAction a;
+  a.type = type;
+  a.r1 = static_cast<int8_t>(robot);
+  a.obj = static_cast<int16_t>(node);
+  return a;
+}
+
+}  // namespace
 
 const std::vector<int>& TaskSearch::GraspIds(int node, int robot) {
   auto [it, inserted] = grasp_ids_.try_emplace({node, world_.robots[robot].grasp_set});
@@ -118,10 +131,7 @@ void TaskSearch::PickSuccessors(const SymState& s, int robot, int node, std::spa
   if (loc < 0 || s.NumHolders(node) != 0) return;
   for (int grasp : grasps) {
     if (!CheapPick(robot, node, loc, grasp)) continue;
-    TaskAction a;
-    a.type = ActionType::kPick;
-    a.r1 = static_cast<int8_t>(robot);
-    a.obj = static_cast<int16_t>(node);
+    TaskAction a = ActionOn(ActionType::kPick, robot, node);
     a.grasp = grasp;
     Push(s, a, out);
   }
@@ -142,10 +152,7 @@ void TaskSearch::AddGraspSuccessors(const SymState& s, const Milestone& m, bool 
     }
     if (!apart) continue;
     if (loc >= 0 && !CheapPick(robot, node, loc, grasp)) continue;
-    TaskAction a;
-    a.type = ActionType::kAddGrasp;
-    a.r1 = static_cast<int8_t>(robot);
-    a.obj = static_cast<int16_t>(node);
+    TaskAction a = ActionOn(ActionType::kAddGrasp, robot, node);
     a.grasp = grasp;
     Push(s, a, out);
   }
@@ -161,11 +168,8 @@ void TaskSearch::HandoverSuccessors(const SymState& s, int robot, int node,
   }
   for (int grasp : grasps) {
     if (!HandsApart(giver, s.grasp[giver], robot, grasp)) continue;
-    TaskAction a;
-    a.type = ActionType::kHandover;
-    a.r1 = static_cast<int8_t>(giver);
+    TaskAction a = ActionOn(ActionType::kHandover, giver, node);
     a.r2 = static_cast<int8_t>(robot);
-    a.obj = static_cast<int16_t>(node);
     a.grasp = grasp;
     Push(s, a, out);
   }
@@ -175,11 +179,7 @@ void TaskSearch::ReleaseSuccessor(const SymState& s, int robot, SuccessorList& o
   // Let go of an object that rests or that another hand holds.
   const int o = s.held[robot];
   if (s.loc[o] < 0 && s.NumHolders(o) < 2) return;
-  TaskAction a;
-  a.type = ActionType::kRelease;
-  a.r1 = static_cast<int8_t>(robot);
-  a.obj = static_cast<int16_t>(o);
-  Push(s, a, out);
+  Push(s, ActionOn(ActionType::kRelease, robot, o), out);
 }
 
 void TaskSearch::PlaceSuccessors(const SymState& s, const Resolution& res, int robot,
@@ -204,10 +204,7 @@ void TaskSearch::PlaceSuccessors(const SymState& s, const Resolution& res, int r
         const Iso3 X = PlacementPose(slot, slots.yaws_rad[y], placements[p]);
         const int id = tables_.PlacedLocation(o, p, static_cast<int>(si), y, X);
         if (!CheapPlace(robot, o, id, s.grasp[robot])) continue;
-        TaskAction a;
-        a.type = ActionType::kPlace;
-        a.r1 = static_cast<int8_t>(robot);
-        a.obj = static_cast<int16_t>(o);
+        TaskAction a = ActionOn(ActionType::kPlace, robot, o);
         a.loc = id;
         Push(s, a, out);
       }
@@ -234,10 +231,7 @@ void TaskSearch::AssembleSuccessor(const SymState& s, const Milestone& m, Succes
   if (s.loc[m.moved] == kInAir && s.NumHolders(m.moved) >= 1 &&
       (s.loc[m.base] >= 0 || s.NumHolders(m.base) >= 1) && TargetAllows(s, m) &&
       CheapAssemble(s, m)) {
-    TaskAction a;
-    a.type = ActionType::kAssemble;
-    a.obj = static_cast<int16_t>(m.step);
-    Push(s, a, out);
+    Push(s, ActionOn(ActionType::kAssemble, -1, m.step), out);
   }
 }
 
