@@ -8,7 +8,10 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "gui/document.h"
 #include "gui_fixture.h"
@@ -272,6 +275,26 @@ TEST(GuiCli, AFailingScriptLineExitsOne) {
       WrapUnderXvfb(dir, "'" + ExampleProject("stool").string() + "' --script f.wrapscript");
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_NE(r.output.find("two inputs"), std::string::npos) << r.output;
+}
+
+// A failing check (an expect-* line, run after the frame it reads) names its line once: one from
+// the script's own checks (script_expect.cpp), one from the authoring ones (script_authoring.cpp).
+TEST(GuiCli, AFailingCheckNamesItsLineOnce) {
+  ASSERT_TRUE(HaveXvfb()) << "xvfb-run not installed (scripts/install_deps.sh installs it)";
+  const auto dir = ScratchDir("gui_cli_failing_check");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"select step seat+leg1\nexpect-selected step seat+leg2\n",
+       "script line 2: selected step is 'seat+leg1', not 'seat+leg2'"},
+      {"expect-count parts 9\n", "script line 1: the project has 5 parts, not 9"}};
+  for (const auto& [script, message] : cases) {
+    std::ofstream(dir / "check.wrapscript", std::ios::trunc) << script;
+    const ProcessRun r =
+        WrapUnderXvfb(dir, "'" + ExampleProject("stool").string() + "' --script check.wrapscript");
+    EXPECT_EQ(r.code, 1) << r.output;
+    const size_t at = r.output.find(message);
+    EXPECT_NE(at, std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("script line"), at) << "named more than once:\n" << r.output;
+  }
 }
 
 TEST(GuiCli, NoDisplayIsBadInputWithAHint) {

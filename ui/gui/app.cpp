@@ -99,8 +99,10 @@ void App::Frame(render::Image* capture) {
     } else if (fs::path(f).extension() == ".urdf") {
       robots_.AddUrdf(s_, f);
     } else {
-      s_.Notify("Dropped file not recognised (a mesh or STEP file, a robot .urdf or a project "
-                ".json): " + f);
+      s_.Notify(
+          "Dropped file not recognised (a mesh or STEP file, a robot .urdf or a project "
+          ".json): " +
+          f);
     }
   }
   TakeRun();
@@ -485,10 +487,10 @@ int AfterScriptLine(App& app, const ScriptLine& line, Result<ScriptEffect>& effe
   }
   app.Frame(nullptr);
   if (effect->check) {
-    // Checks that read what the frame drew (the canvas's marks, the viewport's state).
+    // Checks that read what the frame drew (the canvas's marks, the viewport's state). Their
+    // message names the line already ("script line N: ...").
     if (auto checked = effect->check(s); !checked) {
-      err << options.script << ": script line " << line.number << ": " << checked.error().message
-          << "\n";
+      err << options.script << ": " << checked.error().message << "\n";
       return 1;
     }
   }

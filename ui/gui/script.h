@@ -95,7 +95,8 @@ struct ScriptEffect {
   bool wait_for_authoring = false;   ///< Hold the script until the authoring run is taken.
   std::string measure;               ///< Measure the frame rate: "idle", "orbit" or "play".
   double measure_s = 0.0;            ///< ... for this long [s].
-  /// A check of what the next frame drew (run after it); fails the line with its message.
+  /// A check of what the next frame drew (run after it); fails the line with its message, which
+  /// names the line ("script line N: ...").
   std::function<Result<void>(const AppState&)> check;
 };
 
@@ -103,7 +104,7 @@ struct ScriptEffect {
 const std::map<std::string, std::pair<int, int>>& GeometryScriptArity();
 /// Runs one of them (nullopt when `line` is another command).
 std::optional<Result<ScriptEffect>> RunGeometryScriptLine(AppState& app, const ScriptLine& line,
-                                                         const std::filesystem::path& base_dir);
+                                                          const std::filesystem::path& base_dir);
 
 /// Runs one line against `app`; relative paths resolve against `base_dir`. A refused edit fails
 /// with its reason (kInvalidInput), prefixed by the line number.

@@ -8,18 +8,20 @@
 #include "gui/geometry_view.h"
 #include "gui/panels.h"
 #include "gui/script.h"
+#include "gui/script_internal.h"
 #include "mating/insertion.h"
 
 namespace wrap::gui {
 
 namespace fs = std::filesystem;
 
-namespace {
+using script_detail::Check;
+using script_detail::LineError;
+using script_detail::Resolve;
+using script_detail::Rest;
+using script_detail::RunEdit;
 
-std::unexpected<Error> LineFail(const ScriptLine& line, const std::string& message) {
-  return Fail(ErrorCode::kInvalidInput,
-              "script line " + std::to_string(line.number) + ": " + message);
-}
+namespace {
 
 const Step* FindStep(const Project& p, const std::string& name) {
   for (const Step& s : p.steps) {
@@ -28,26 +30,18 @@ const Step* FindStep(const Project& p, const std::string& name) {
   return nullptr;
 }
 
-std::string Joined(const std::vector<std::string>& words, size_t first) {
-  std::string out;
-  for (size_t i = first; i < words.size(); ++i) out += (i > first ? " " : "") + words[i];
-  return out;
-}
-
-using Check = std::function<Result<void>(const AppState&)>;
-
 // The verdict of the validation on step `name` as the document has it now.
 Result<StepVerdict> VerdictOf(const AppState& app, const ScriptLine& line,
                               const std::string& name) {
   const Step* step = FindStep(app.doc.project(), name);
-  if (!step) return LineFail(line, "there is no step '" + name + "'");
+  if (!step) return LineError(line, "there is no step '" + name + "'");
   // The result is copied into a holder that outlives the verdict's pointers.
   static thread_local ValidationResult held;
   held = app.validation.result();
   auto verdict = FindStepVerdict(held, *step);
   if (!verdict) {
-    return LineFail(line, "no geometry verdict for step '" + name +
-                              "' as it is now (run `validate` first)");
+    return LineError(
+        line, "no geometry verdict for step '" + name + "' as it is now (run `validate` first)");
   }
   return *verdict;
 }
@@ -56,21 +50,23 @@ Result<Check> GeometryCheck(const ScriptLine& line) {
   const std::vector<std::string>& w = line.words;
   const std::string& cmd = w[0];
   if (cmd == "expect-path") {
-    if (w[2] != "free" && w[2] != "blocked") return LineFail(line, "expect-path STEP free|blocked");
+    if (w[2] != "free" && w[2] != "blocked") {
+      return LineError(line, "expect-path STEP free|blocked");
+    }
     const std::string step = w[1];
     const bool blocked = w[2] == "blocked";
     return Check([line, step, blocked](const AppState& app) -> Result<void> {
       auto v = VerdictOf(app, line, step);
       if (!v) return std::unexpected(v.error());
       if (v->geometry->blocked() == blocked) return {};
-      return LineFail(line, "step '" + step + "': " +
-                                PathVerdictText(*v, *FindStep(app.doc.project(), step)));
+      return LineError(
+          line, "step '" + step + "': " + PathVerdictText(*v, *FindStep(app.doc.project(), step)));
     });
   }
   if (cmd == "expect-free-direction") {
     Vec3 d;
     for (int i = 0; i < 3; ++i) d[i] = std::strtod(w[2 + i].c_str(), nullptr);
-    if (!(d.norm() > 1e-9)) return LineFail(line, "expect-free-direction STEP X Y Z: not zero");
+    if (!(d.norm() > 1e-9)) return LineError(line, "expect-free-direction STEP X Y Z: not zero");
     const std::string step = w[1];
     const Vec3 want = d.normalized();
     return Check([line, step, want](const AppState& app) -> Result<void> {
@@ -81,9 +77,8 @@ Result<Check> GeometryCheck(const ScriptLine& line) {
         if (f.normalized().dot(want) > std::cos(3.0 * M_PI / 180.0)) return {};
         found += " " + FormatDirection(f);
       }
-      return LineFail(line, "step '" + step + "' has no free direction " +
-                                FormatDirection(want) + "; free:" +
-                                (found.empty() ? " none" : found));
+      return LineError(line, "step '" + step + "' has no free direction " + FormatDirection(want) +
+                                 "; free:" + (found.empty() ? " none" : found));
     });
   }
   if (cmd == "expect-touch" || cmd == "expect-no-touch") {
@@ -91,16 +86,16 @@ Result<Check> GeometryCheck(const ScriptLine& line) {
     const std::string a = w[1], b = w[2];
     return Check([line, a, b, want](const AppState& app) -> Result<void> {
       const ValidationResult v = app.validation.result();
-      if (!v.geometry) return LineFail(line, "no contact graph yet (run `validate` first)");
+      if (!v.geometry) return LineError(line, "no contact graph yet (run `validate` first)");
       if (PartsTouch(v, a, b) == want) return {};
-      return LineFail(line, "'" + a + "' and '" + b + (want ? "' do not touch" : "' touch"));
+      return LineError(line, "'" + a + "' and '" + b + (want ? "' do not touch" : "' touch"));
     });
   }
   if (cmd == "expect-count") {
     const std::string what = w[1];
     const long n = std::strtol(w[2].c_str(), nullptr, 10);
     if (what != "parts" && what != "steps" && what != "robots") {
-      return LineFail(line, "expect-count parts|steps|robots N");
+      return LineError(line, "expect-count parts|steps|robots N");
     }
     return Check([line, what, n](const AppState& app) -> Result<void> {
       const Project& p = app.doc.project();
@@ -108,20 +103,20 @@ Result<Check> GeometryCheck(const ScriptLine& line) {
                                          : what == "steps" ? p.steps.size()
                                                            : p.robots.size());
       if (got == n) return {};
-      return LineFail(line, "the project has " + std::to_string(got) + " " + what + ", not " +
-                                std::to_string(n));
+      return LineError(line, "the project has " + std::to_string(got) + " " + what + ", not " +
+                                 std::to_string(n));
     });
   }
   if (cmd == "expect-change") {
-    const std::string text = Joined(w, 1);
+    const std::string text = Rest(line, 1);
     return Check([line, text](const AppState& app) -> Result<void> {
       for (const std::string& l : app.authoring_log.lines) {
         if (l.find(text) != std::string::npos) return {};
       }
       std::string shown;
       for (const std::string& l : app.authoring_log.lines) shown += "\n  " + l;
-      return LineFail(line, "the last changes do not say '" + text + "'; they say:" +
-                                (shown.empty() ? " nothing" : shown));
+      return LineError(line, "the last changes do not say '" + text +
+                                 "'; they say:" + (shown.empty() ? " nothing" : shown));
     });
   }
   return Check{};
@@ -140,7 +135,7 @@ const std::map<std::string, std::pair<int, int>>& GeometryScriptArity() {
 }
 
 std::optional<Result<ScriptEffect>> RunGeometryScriptLine(AppState& app, const ScriptLine& line,
-                                                         const fs::path& base) {
+                                                          const fs::path& base) {
   const std::vector<std::string>& w = line.words;
   const std::string& cmd = w[0];
   if (!GeometryScriptArity().contains(cmd)) return std::nullopt;
@@ -148,19 +143,19 @@ std::optional<Result<ScriptEffect>> RunGeometryScriptLine(AppState& app, const S
   if (cmd == "import-assembly" || cmd == "suggest-order" || cmd == "lay-out") {
     std::vector<fs::path> meshes;
     LengthUnit unit = LengthUnit::kAuto;
-    AuthoringKind kind = cmd == "suggest-order" ? AuthoringKind::kSuggestOrder
-                                                : AuthoringKind::kLayOut;
+    AuthoringKind kind =
+        cmd == "suggest-order" ? AuthoringKind::kSuggestOrder : AuthoringKind::kLayOut;
     if (cmd == "import-assembly") {
       kind = AuthoringKind::kImportAssembly;
       auto u = ParseLengthUnit(w[1]);
-      if (!u) return LineFail(line, "import-assembly UNIT PATH...: UNIT is auto, mm, cm or m");
+      if (!u) return LineError(line, "import-assembly UNIT PATH...: UNIT is auto, mm, cm or m");
       unit = *u;
       for (size_t i = 2; i < w.size(); ++i) {
-        meshes.push_back(fs::path(w[i]).is_absolute() ? fs::path(w[i]) : base / w[i]);
+        meshes.push_back(Resolve(base, w[i]));
       }
     }
     if (!StartAuthoring(app, kind, meshes, unit)) {
-      return LineFail(line, "an authoring run is under way");
+      return LineError(line, "an authoring run is under way");
     }
     effect.wait_for_authoring = true;
     return effect;
@@ -171,12 +166,10 @@ std::optional<Result<ScriptEffect>> RunGeometryScriptLine(AppState& app, const S
     const std::vector<Vec3> free = RankedFreeDirections(*v->geometry);
     const long n = std::strtol(w[2].c_str(), nullptr, 10);
     if (n < 1 || n > static_cast<long>(free.size())) {
-      return LineFail(line, "step '" + w[1] + "' shows " + std::to_string(free.size()) +
-                                " free direction(s)");
+      return LineError(
+          line, "step '" + w[1] + "' shows " + std::to_string(free.size()) + " free direction(s)");
     }
-    if (auto done = app.doc.Execute(UseInsertionAxis(w[1], free[n - 1])); !done) {
-      return LineFail(line, done.error().message);
-    }
+    if (auto done = RunEdit(app, line, UseInsertionAxis(w[1], free[n - 1])); !done) return done;
     app.Notify("Step '" + w[1] + "': insertion axis set to " + FormatDirection(free[n - 1]));
     return effect;
   }

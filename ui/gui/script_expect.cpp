@@ -2,7 +2,6 @@
 // or the state it left (the Problems panel, the canvas's mark, the selection, the plan's
 // staleness, a field's refusal, the undo label, the viewport), expect-plan and expect-refused.
 #include <algorithm>
-#include <functional>
 
 #include "gui/panels.h"
 #include "gui/script_internal.h"
@@ -12,9 +11,6 @@ namespace wrap::gui::script_detail {
 namespace fs = std::filesystem;
 
 namespace {
-
-/// A check of the state a frame left; fails with the line's message.
-using Check = std::function<Result<void>(const AppState&)>;
 
 /// Every line the Problems panel shows: the run's failure (its headline and each failed check)
 /// and the validation's diagnostics ("step 's1' / mating.force_N: MESSAGE").

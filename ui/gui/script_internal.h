@@ -1,9 +1,11 @@
-// Internal to the scripted mode (script.cpp, script_edit.cpp, script_expect.cpp): the line
-// helpers every verb uses and the verb handlers the table in script.cpp dispatches to.
+// Internal to the scripted mode (script.cpp, script_edit.cpp, script_expect.cpp,
+// script_authoring.cpp): the line helpers every verb uses and the verb handlers the table in
+// script.cpp dispatches to.
 #pragma once
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -26,6 +28,8 @@ std::string Rest(const ScriptLine& line, size_t first);
 std::filesystem::path Resolve(const std::filesystem::path& base, const std::string& file);
 /// Runs `command` on the document; a refusal fails the line with its reason.
 Result<ScriptEffect> RunEdit(AppState& app, const ScriptLine& line, const Command& command);
+/// A check of the state a frame left (ScriptEffect::check); fails with the line's message.
+using Check = std::function<Result<void>(const AppState&)>;
 
 /// What one verb does: its edit of `app` (or nothing) and what it asks of the frame loop.
 using VerbHandler = Result<ScriptEffect> (*)(AppState& app, const ScriptLine& line,
