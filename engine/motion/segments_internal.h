@@ -248,8 +248,14 @@ class SegmentBuilder {
 
   // --- Skills (skills.cpp).
   // Backs robot r's TCP away from q along its approach axis (TCP z) by up to approach_m,
-  // collision-free in the current scene; the waypoints from q outwards, or empty.
-  std::vector<JointVector> BackOff(int robot, const JointVector& q, double* length);
+  // collision-free in the current scene, to an end that `end_clear` (when given) accepts; the
+  // waypoints from q outwards, or empty.
+  std::vector<JointVector> BackOff(int robot, const JointVector& q, double* length,
+                                   const std::function<bool(const JointVector&)>& end_clear = {});
+  // Robot r at q_end touches nothing in the scene of `openings` with no gripper contact
+  // allowed; the scene is then set again with `gripper_ok` (the straight move's), robots at cur_.
+  bool EndClear(int robot, const JointVector& q_end, const std::vector<double>& openings,
+                const std::vector<std::pair<int, int>>& gripper_ok);
   // A robot that let go of an object (released_) backs its gripper away from it.
   bool Retreat(int action, int robot);
   bool Lift(int action, int node, const std::vector<int>& holders);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,7 +19,9 @@
 
 namespace wrap::detail {
 
-std::vector<JointVector> SegmentBuilder::BackOff(int robot, const JointVector& q, double* length) {
+std::vector<JointVector> SegmentBuilder::BackOff(
+    int robot, const JointVector& q, double* length,
+    const std::function<bool(const JointVector&)>& end_clear) {
   const Iso3 X0 = Tcp(robot, q);
   const Vec3 axis = X0.linear().col(2);
   // The straight move back by d, collision-free, or empty (last_hit_ says why).
@@ -34,6 +37,12 @@ std::vector<JointVector> SegmentBuilder::BackOff(int robot, const JointVector& q
     if (path.empty()) {
       last_hit_ = "no IK solution along the line";
     } else if (PathClear({robot}, path)) {
+      // The move may graze what the gripper let go of (or is about to hold) on its way; where it
+      // ends, a free path starts or ends, and there it must touch nothing.
+      if (end_clear && !end_clear(path.back()[0])) {
+        last_hit_ = StrFormat("%.1f mm back the gripper still touches the object", d * 1e3);
+        return out;
+      }
       for (auto& wp : path) out.push_back(wp[0]);
     }
     return out;
@@ -63,17 +72,36 @@ std::vector<JointVector> SegmentBuilder::BackOff(int robot, const JointVector& q
   return {};
 }
 
+bool SegmentBuilder::EndClear(int robot, const JointVector& q_end,
+                              const std::vector<double>& openings,
+                              const std::vector<std::pair<int, int>>& gripper_ok) {
+  const JointVector start = cur_[robot];
+  cur_[robot] = q_end;
+  const bool clear =
+      SetScene(openings).has_value() && !scene_.Collides(std::span<const int>(&robot, 1));
+  cur_[robot] = start;
+  // Back to the scene the straight move is checked in.
+  return SetScene(openings, {}, {}, gripper_ok).has_value() && clear;
+}
+
 bool SegmentBuilder::Retreat(int action, int robot) {
   const int node = released_[robot];
   if (node < 0) return true;
   if (!SetScene(opening_, {}, {}, {{robot, node}})) return false;
+  auto end_clear = [&](const JointVector& q_end) {
+    return EndClear(robot, q_end, opening_, {{robot, node}});
+  };
   double length = 0.0;
-  std::vector<JointVector> back = BackOff(robot, cur_[robot], &length);
+  std::vector<JointVector> back = BackOff(robot, cur_[robot], &length, end_clear);
   if (back.empty()) {
     return Fail(action, SegmentKind::kRetreat, false,
                 Name(robot) + " cannot back its gripper away from " + NodeName(node) +
                     " along the gripper axis: " + last_hit_,
                 released_at_[robot]);
+  }
+  if (ctx_.Logs("motion") && length < opt_.skills.approach_m) {
+    ctx_.Log("motion", StrFormat("retreat: action %d %s backs only %.1f mm", action + 1,
+                                 Name(robot).c_str(), length * 1e3));
   }
   PushSkill(SegmentKind::kRetreat, action, false, robot, node, back, length, opt_.skill_speed_mps);
   released_[robot] = -1;
@@ -204,7 +232,10 @@ bool SegmentBuilder::BackOffGrasp(int i, const ActionWork& w, int r, const Joint
   }
   auto set = SetScene(openings, {}, {}, {{r, w.grasped}});
   if (!set) return false;
-  back = BackOff(r, q, &length);
+  auto end_clear = [&](const JointVector& q_end) {
+    return EndClear(r, q_end, openings, {{r, w.grasped}});
+  };
+  back = BackOff(r, q, &length, end_clear);
   for (size_t c = 0; c < carriers_now.size(); ++c) cur_[carriers_now[c]] = saved_carriers[c];
   std::swap(state_, at);
   cur_[r] = saved;
