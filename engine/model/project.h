@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/pose.h"
@@ -61,7 +62,7 @@ struct Mating {
   /// The final travel [m] in which the inputs may interfere (snap and press fits): within it the
   /// geometry checks allow `interference_depth_m` of overlap, before it only touching.
   double interference_travel_m = 1e-3;
-  double interference_depth_m = 5e-4;  ///< Most overlap allowed in that final travel [m].
+  double interference_depth_m = 5e-4;          ///< Most overlap allowed in that final travel [m].
   std::optional<WrenchBox> connection_limits;  ///< T_pq in the mating frame; default: project's.
   bool operator==(const Mating&) const = default;
 };
@@ -166,5 +167,17 @@ struct Project {
   StepTessellation tessellation;         ///< How STEP meshes are tessellated.
   bool operator==(const Project&) const = default;
 };
+
+/// The step named `name`, or null.
+inline const Step* FindStep(const Project& project, const std::string& name) {
+  for (const Step& step : project.steps) {
+    if (step.name == name) return &step;
+  }
+  return nullptr;
+}
+/// The step named `name`, or null (to edit it).
+inline Step* FindStep(Project& project, const std::string& name) {
+  return const_cast<Step*>(FindStep(std::as_const(project), name));
+}
 
 }  // namespace wrap

@@ -25,20 +25,6 @@ Part* FindPart(Project& p, const std::string& name) {
   return nullptr;
 }
 
-Step* FindStep(Project& p, const std::string& name) {
-  for (Step& step : p.steps) {
-    if (step.name == name) return &step;
-  }
-  return nullptr;
-}
-
-const Step* FindStep(const Project& p, const std::string& name) {
-  for (const Step& step : p.steps) {
-    if (step.name == name) return &step;
-  }
-  return nullptr;
-}
-
 Robot* FindRobot(Project& p, const std::string& name) {
   for (Robot& robot : p.robots) {
     if (robot.name == name) return &robot;

@@ -24,13 +24,6 @@ constexpr float kColGap = 44.0f;  // between columns
 constexpr float kPadX = 16.0f;    // text padding inside a node
 constexpr float kMinZoom = 0.3f;
 
-const Step* FindStep(const Project& p, const std::string& name) {
-  for (const Step& s : p.steps) {
-    if (s.name == name) return &s;
-  }
-  return nullptr;
-}
-
 /// A node's width from its name at the default font size (canvas units).
 float NodeWidth(const std::string& name) {
   const float text = ImGui::GetCurrentContext() ? ImGui::CalcTextSize(name.c_str()).x

@@ -23,13 +23,6 @@ using script_detail::RunEdit;
 
 namespace {
 
-const Step* FindStep(const Project& p, const std::string& name) {
-  for (const Step& s : p.steps) {
-    if (s.name == name) return &s;
-  }
-  return nullptr;
-}
-
 // The verdict of the validation on step `name` as the document has it now.
 Result<StepVerdict> VerdictOf(const AppState& app, const ScriptLine& line,
                               const std::string& name) {
