@@ -5,6 +5,7 @@
 #include "authoring/suggest.h"
 #include "cli.h"
 #include "load.h"
+#include "model/entity_path.h"
 #include "model/project_io.h"
 
 namespace wrap::cli {
@@ -48,7 +49,8 @@ int SuggestCommand(const SuggestArgs& args, std::ostream& out, std::ostream& err
   }
   const LoadedProject loaded = LoadProject(args.project);
   if (!loaded.project || !loaded.check.tree) {
-    for (const Diagnostic& d : loaded.check.diagnostics.items) err << Format(d) << "\n";
+    for (const Diagnostic& d : loaded.check.diagnostics.items)
+      err << FormatNamed(d, loaded.project ? &*loaded.project : nullptr) << "\n";
     err << args.project << ": cannot be read well enough to suggest fixes\n";
     return 2;
   }

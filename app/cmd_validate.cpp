@@ -2,8 +2,9 @@
 #include <ostream>
 
 #include "cli.h"
-#include "load.h"
 #include "grasp/preprocess.h"
+#include "load.h"
+#include "model/entity_path.h"
 #include "task/plan_json.h"
 #include "task/planner.h"
 
@@ -31,10 +32,11 @@ Diagnostics StartPickWarnings(const LoadedProject& loaded, const std::string& pr
   return out;
 }
 
-void PrintDiagnostics(const Diagnostics& diags, bool errors_only, std::ostream& err) {
+void PrintDiagnostics(const Diagnostics& diags, const Project* project, bool errors_only,
+                      std::ostream& err) {
   for (const Diagnostic& d : diags.items) {
     if (errors_only && d.severity != Severity::kError) continue;
-    err << Format(d) << "\n";
+    err << FormatNamed(d, project) << "\n";
   }
 }
 
@@ -56,7 +58,7 @@ int Validate(const std::string& project, const std::string& plan_file, bool quie
   LoadedProject loaded = LoadChecked(project, &geometry);
   if (loaded.ok()) loaded.check.diagnostics.Append(StartPickWarnings(loaded, project));
   const Diagnostics& diags = loaded.check.diagnostics;
-  PrintDiagnostics(diags, quiet, err);
+  PrintDiagnostics(diags, loaded.project ? &*loaded.project : nullptr, quiet, err);
   if (!loaded.ok()) {
     if (!quiet) {
       err << project << ": invalid: " << diags.error_count() << " error(s), "

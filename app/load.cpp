@@ -3,8 +3,9 @@
 #include <cstdio>
 #include <ostream>
 
-#include "model/project_io.h"
 #include "mating/project_check.h"
+#include "model/entity_path.h"
+#include "model/project_io.h"
 
 namespace wrap::cli {
 
@@ -28,7 +29,8 @@ bool ReportLoad(const LoadedProject& loaded, const std::string& project, std::os
                 bool warnings) {
   const Diagnostics& diags = loaded.check.diagnostics;
   if (warnings || !loaded.ok()) {
-    for (const Diagnostic& d : diags.items) err << Format(d) << "\n";
+    const Project* named = loaded.project ? &*loaded.project : nullptr;
+    for (const Diagnostic& d : diags.items) err << FormatNamed(d, named) << "\n";
   }
   if (!loaded.ok()) {
     err << project << ": invalid: " << diags.error_count() << " error(s); run 'wrap validate'\n";

@@ -1,8 +1,8 @@
 #include "authoring/new_project.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <map>
 
 #include "authoring/layout.h"
@@ -10,6 +10,7 @@
 #include "grasp/grasp_probe.h"
 #include "mating/check.h"
 #include "model/catalog.h"
+#include "model/entity_path.h"
 
 namespace wrap {
 
@@ -121,13 +122,13 @@ Result<NewProjectResult> NewProject(const std::vector<fs::path>& meshes, const f
   auto& log = out.decisions;
   if (!FindRobotModel(options.robot_model)) {
     return Fail(ErrorCode::kInvalidInput, "--robot-model: unknown robot model '" +
-                                              options.robot_model + "' (known: " +
-                                              RobotModelNames() + ")");
+                                              options.robot_model +
+                                              "' (known: " + RobotModelNames() + ")");
   }
   if (!FindEndEffector(options.end_effector)) {
     return Fail(ErrorCode::kInvalidInput, "--end-effector: unknown end effector '" +
-                                              options.end_effector + "' (known: " +
-                                              EndEffectorNames() + ")");
+                                              options.end_effector +
+                                              "' (known: " + EndEffectorNames() + ")");
   }
   if (options.robots < 1 || options.robots > 12) {
     return Fail(ErrorCode::kInvalidInput, "--robots: between 1 and 12");
@@ -198,25 +199,27 @@ Result<NewProjectResult> NewProject(const std::vector<fs::path>& meshes, const f
   Project& p = out.project;
   p.name = options.name.empty() ? output.stem().string() : options.name;
   const bool step = !intake->solids.front().empty();
-  p.description = "Made by wrap new from " +
-                  (step ? std::to_string(n) + " parts of " + intake->files.front().filename().string()
-                        : std::to_string(n) + " meshes (" + ToString(intake->unit) + ")") +
-                  ": the DAG by assembly-by-disassembly, initial poses from stable placements a "
-                  "robot can pick.";
+  p.description =
+      "Made by wrap new from " +
+      (step ? std::to_string(n) + " parts of " + intake->files.front().filename().string()
+            : std::to_string(n) + " meshes (" + ToString(intake->unit) + ")") +
+      ": the DAG by assembly-by-disassembly, initial poses from stable placements a "
+      "robot can pick.";
   p.table = TableFor(options.robot_model);
   p.planner.grasps = options.grasps;
   AddParts(*intake, output, p);
   if (auto ok = AddSteps(seq, options, p); !ok) return std::unexpected(ok.error());
   p.robots = RobotsAroundTable(p.table, options.robots, options.robot_model, options.end_effector);
-  log.push_back("robots: " + std::to_string(options.robots) + " " + options.robot_model +
-                " with " + options.end_effector + " around the table, facing its centre");
+  log.push_back("robots: " + std::to_string(options.robots) + " " + options.robot_model + " with " +
+                options.end_effector + " around the table, facing its centre");
   for (Part& part : p.parts) part.initial_pose.xyz = Vec3(0, 0, p.table.height);
 
   // The layout needs the project's own view of the meshes (as validation reads them).
   ProjectCheck check = ValidateProject(p, output);
   for (const Diagnostic& d : check.diagnostics.items) {
     if (d.severity == Severity::kError) {
-      return Fail(ErrorCode::kInternal, "wrap new: the project does not validate: " + Format(d));
+      return Fail(ErrorCode::kInternal,
+                  "wrap new: the project does not validate: " + FormatNamed(d, p));
     }
   }
   tell("laying out the parts on the table", 0.6);

@@ -104,4 +104,22 @@ EntityRef EntityOfPath(const Project& project, const std::string& json_path) {
   return ref;
 }
 
+std::string FormatNamed(const Diagnostic& d, const Project& project) {
+  const EntityRef ref = EntityOfPath(project, d.path);
+  const bool named = (ref.kind == EntityKind::kPart || ref.kind == EntityKind::kStep ||
+                      ref.kind == EntityKind::kRobot || ref.kind == EntityKind::kMobileBase) &&
+                     !ref.name.empty();
+  if (!named) return Format(d);
+  Diagnostic shown = d;
+  const std::string label = ref.Label();
+  shown.path = label + (ref.field.empty() ? std::string() : ", " + ref.field);
+  // A message that starts by naming its entity need not say it twice.
+  if (shown.message.starts_with(label + ": ")) shown.message.erase(0, label.size() + 2);
+  return Format(shown);
+}
+
+std::string FormatNamed(const Diagnostic& d, const Project* project) {
+  return project ? FormatNamed(d, *project) : Format(d);
+}
+
 }  // namespace wrap

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "core/diagnostics.h"
 #include "model/project.h"
 
 namespace wrap {
@@ -25,5 +26,14 @@ struct EntityRef {
 /// An index beyond the project's lists, or a top-level key it does not know, gives kOther with
 /// the path itself as the field.
 EntityRef EntityOfPath(const Project& project, const std::string& json_path);
+
+/// A diagnostic in one line with its entity named rather than indexed, for people reading a
+/// terminal: `stool.json: part 'leg_1', mesh: error: ...` where Format(d) gives
+/// `stool.json: parts[1].mesh: error: ...`. A path that names no entity of `project` (the table,
+/// the planner, an index beyond its lists, a part without a name) is printed as Format prints it.
+std::string FormatNamed(const Diagnostic& d, const Project& project);
+
+/// FormatNamed when `project` is known, Format otherwise.
+std::string FormatNamed(const Diagnostic& d, const Project* project);
 
 }  // namespace wrap

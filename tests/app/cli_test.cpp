@@ -56,12 +56,12 @@ TEST(Cli, ValidateReportsEveryProblemOnStderr) {
     "robots": [{"name": "r", "model": "ur3", "end_effector": "robotiq_2f85"}]})");
   const CliRun r = Wrap({"validate", f.string()});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("broken.json: parts[0].scale: error: must be positive"), std::string::npos)
+  EXPECT_NE(r.err.find("broken.json: part 'a', scale: error: must be positive"), std::string::npos)
       << r.err;
-  EXPECT_NE(r.err.find("broken.json: parts[0].mesh: error: file 'nope.stl' not found"),
+  EXPECT_NE(r.err.find("broken.json: part 'a', mesh: error: file 'nope.stl' not found"),
             std::string::npos)
       << r.err;
-  EXPECT_NE(r.err.find("robots[0].model: error: unknown robot model 'ur3'"), std::string::npos);
+  EXPECT_NE(r.err.find("robot 'r', model: error: unknown robot model 'ur3'"), std::string::npos);
   EXPECT_NE(r.err.find("3 error(s)"), std::string::npos) << r.err;
 }
 
@@ -95,7 +95,7 @@ TEST(Cli, ValidateImportsUrdfRobots) {
   EXPECT_EQ(r.code, 0) << r.err;
   r = Wrap({"validate", TempFile("urdf_forked.json", project("forked_arm.urdf", "")).string()});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("robots[0].urdf: error: cannot use URDF 'forked_arm.urdf'"),
+  EXPECT_NE(r.err.find("robot 'r', urdf: error: cannot use URDF 'forked_arm.urdf'"),
             std::string::npos)
       << r.err;
   // Naming the tip resolves it.

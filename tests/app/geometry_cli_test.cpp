@@ -48,7 +48,7 @@ TEST(GeometryCli, SidewaysLegIsRefusedWithTheFreeDirection) {
   });
   const CliRun v = Wrap({"validate", file.string()});
   EXPECT_EQ(v.code, 2) << v.out << v.err;
-  EXPECT_NE(v.err.find("steps[0].mating.axis: error: step 'seat+leg1': 'leg1' moving along "
+  EXPECT_NE(v.err.find("step 'seat+leg1', mating.axis: error: 'leg1' moving along "
                        "[1, 0, 0] hits 'seat'"),
             std::string::npos)
       << v.err;
@@ -76,7 +76,7 @@ TEST(GeometryCli, PartsStackedAtTheStartAreRefused) {
   });
   const CliRun v = Wrap({"validate", file.string()});
   EXPECT_EQ(v.code, 2) << v.out << v.err;
-  EXPECT_NE(v.err.find("parts[2].initial_pose: error: part 'leg2' overlaps part 'leg1' by "),
+  EXPECT_NE(v.err.find("part 'leg2', initial_pose: error: part 'leg2' overlaps part 'leg1' by "),
             std::string::npos)
       << v.err;
 }
@@ -118,7 +118,7 @@ TEST(GeometryCli, PartThatNoGraspCanTakeFromTheTableIsAWarning) {
   std::ofstream(dir / "plate.json") << project.dump(2);
   const CliRun v = Wrap({"validate", (dir / "plate.json").string()});
   EXPECT_EQ(v.code, 0) << v.err;  // a warning, not an error
-  EXPECT_NE(v.err.find("parts[1].initial_pose: warning: no grasp of 'plate' can be taken where it "
+  EXPECT_NE(v.err.find("part 'plate', initial_pose: warning: no grasp of 'plate' can be taken where it "
                        "rests (every one of the"),
             std::string::npos)
       << v.err;

@@ -540,5 +540,31 @@ TEST(EntityPath, NamesTheEntityAJsonPathPointsAt) {
   EXPECT_EQ(EntityOfPath(p, "connection_limits.force_N").kind, EntityKind::kProject);
 }
 
+// The terminal's one-line form names entities instead of indexing lists (brief: errors name the
+// field by name, not list index), drops a repeated name, and keeps paths that name no entity.
+TEST(EntityPath, FormatNamedPrintsTheEntityByName) {
+  Project p;
+  p.parts.push_back(Part{});
+  p.parts[0].name = "seat";
+  p.parts.push_back(Part{});  // no name yet: nothing to name it by
+  p.steps.push_back(Step{});
+  p.steps[0].name = "seat+leg1";
+  auto diag = [](std::string path, std::string message, Severity s = Severity::kError) {
+    return Diagnostic{s, "stool.json", std::move(path), std::move(message)};
+  };
+  EXPECT_EQ(FormatNamed(diag("parts[0].mesh", "file 'seat.stl' not found"), p),
+            "stool.json: part 'seat', mesh: error: file 'seat.stl' not found");
+  EXPECT_EQ(FormatNamed(diag("steps[0].mating.axis", "step 'seat+leg1': 'leg1' hits 'seat'"), p),
+            "stool.json: step 'seat+leg1', mating.axis: error: 'leg1' hits 'seat'");
+  EXPECT_EQ(FormatNamed(diag("steps[0]", "joins nothing", Severity::kWarning), p),
+            "stool.json: step 'seat+leg1': warning: joins nothing");
+  EXPECT_EQ(FormatNamed(diag("parts[1].name", "a part needs a non-empty name"), p),
+            "stool.json: parts[1].name: error: a part needs a non-empty name");
+  EXPECT_EQ(FormatNamed(diag("parts[9].mesh", "x"), p), "stool.json: parts[9].mesh: error: x");
+  EXPECT_EQ(FormatNamed(diag("table.friction", "too high"), p),
+            "stool.json: table.friction: error: too high");
+  EXPECT_EQ(FormatNamed(diag("", "malformed JSON"), nullptr), "stool.json: error: malformed JSON");
+}
+
 }  // namespace
 }  // namespace wrap

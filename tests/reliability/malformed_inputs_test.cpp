@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -244,6 +246,25 @@ void ExpectNoOutput(const fs::path& out, const std::string& what) {
   }
 }
 
+/// How stderr names the field at a JSON path of `project`: "parts[1].mesh" of a project whose
+/// second part is 'peg' reads "part 'peg', mesh" (entities by name, not by list index).
+std::string Named(const std::string& phrase, const json& project) {
+  static const std::regex path(R"(^(parts|steps|robots|mobile_bases)\[(\d+)\](\.(.*))?$)");
+  static const std::map<std::string, std::string> kind = {
+      {"parts", "part"}, {"steps", "step"}, {"robots", "robot"}, {"mobile_bases", "mobile base"}};
+  std::smatch m;
+  if (!std::regex_match(phrase, m, path)) return phrase;
+  const json* list = project.is_object() && project.contains(m[1].str()) ? &project[m[1].str()]
+                                                                          : nullptr;
+  const size_t i = std::stoul(m[2].str());
+  if (!list || !list->is_array() || i >= list->size() || !(*list)[i].contains("name") ||
+      !(*list)[i]["name"].is_string() || (*list)[i]["name"].get<std::string>().empty()) {
+    return phrase;
+  }
+  const std::string name = kind.at(m[1].str()) + " '" + (*list)[i]["name"].get<std::string>() + "'";
+  return m[4].matched ? name + ", " + m[4].str() : name;
+}
+
 void ExpectBadInput(const CliRun& r, const std::vector<std::string>& phrases,
                     const std::string& what) {
   EXPECT_EQ(r.code, 2) << what << "\n" << r.err;
@@ -289,9 +310,11 @@ TEST(MalformedInputs, ProjectMeshAndUrdfFiles) {
 #ifdef WRAP_TEST_HAVE_RENDER
     commands.push_back({"render", p, "-o", (out / "render").string()});
 #endif
+    std::vector<std::string> phrases;
+    for (const std::string& phrase : c.phrases) phrases.push_back(Named(phrase, project));
     for (const auto& args : commands) {
       const std::string what = c.name + ": wrap " + args[0];
-      ExpectBadInput(Wrap(args), c.phrases, what);
+      ExpectBadInput(Wrap(args), phrases, what);
     }
     ExpectNoOutput(out, c.name);
     for (const std::string& f : ListFiles(out / "render")) ADD_FAILURE() << c.name << ": " << f;

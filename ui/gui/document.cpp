@@ -4,6 +4,7 @@
 #include <system_error>
 
 #include "core/file_io.h"
+#include "model/entity_path.h"
 #include "model/project_io.h"
 
 namespace wrap::gui {
@@ -34,7 +35,7 @@ Result<Document> Document::Open(const fs::path& path) {
     for (const Diagnostic& d : parse.diagnostics.items) {
       if (d.severity != Severity::kError) continue;
       if (!message.empty()) message += "\n";
-      message += Format(d);
+      message += FormatNamed(d, parse.project ? &*parse.project : nullptr);
     }
     if (message.empty()) message = path.string() + ": not a project file";
     std::error_code ec;
