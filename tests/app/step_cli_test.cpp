@@ -13,6 +13,7 @@
 #include "cli_runner.h"
 #include "generator/step_designs.h"
 #include "geometry/step_cache.h"
+#include "test_build_config.h"
 
 namespace wrap::cli {
 namespace {

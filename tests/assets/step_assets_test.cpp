@@ -9,6 +9,7 @@
 
 #include "generator/step_designs.h"
 #include "geometry/step_import.h"
+#include "test_build_config.h"
 
 #if WRAP_TEST_WITH_OCCT
 namespace wrap::partgen {

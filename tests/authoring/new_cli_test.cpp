@@ -11,6 +11,7 @@
 #include "geometry/step_import.h"
 #include "model/project_io.h"
 #include "model/validate.h"
+#include "test_build_config.h"
 
 namespace wrap::cli {
 namespace {

@@ -19,6 +19,7 @@
 #include "core/file_io.h"
 #include "geometry/mesh_file.h"
 #include "geometry/step_cache.h"
+#include "test_build_config.h"
 
 namespace wrap {
 namespace {

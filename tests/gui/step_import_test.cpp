@@ -13,6 +13,7 @@
 #include "gui/commands.h"
 #include "gui/document.h"
 #include "model/validate.h"
+#include "test_build_config.h"
 
 #if WRAP_TEST_WITH_OCCT
 namespace wrap::gui {

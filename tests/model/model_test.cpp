@@ -15,6 +15,7 @@
 #include "model/paths.h"
 #include "model/project_io.h"
 #include "model/validate.h"
+#include "test_build_config.h"
 
 namespace wrap {
 namespace {

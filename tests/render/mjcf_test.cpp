@@ -11,6 +11,7 @@
 #include "sim/mjcf.h"
 #include "sim/mujoco_model.h"
 #include "sim/scene.h"
+#include "test_build_config.h"
 
 namespace wrap {
 namespace {

@@ -15,6 +15,7 @@
 #include "task/keyframes.h"
 #include "task/plan_json.h"
 #include "task/world.h"
+#include "test_build_config.h"
 
 namespace wrap {
 namespace {
