@@ -72,7 +72,7 @@ KeyframeSolver::KeyframeSolver(const TaskWorld& world, TaskTables& tables,
       options_(options),
       cell_(std::move(cell)),
       counters_(counters),
-      checker_(WrenchOptions{}) {
+      checker_(WrenchOptions{.first_failure_suffices = true}) {
   frames_.resize(world.robots.size());
   for (size_t r = 0; r < world.robots.size(); ++r) {
     frames_[r].resize(world.robots[r].chain.links.size());

@@ -93,6 +93,19 @@ struct WrenchChecker::Impl {
   std::uint64_t fallbacks = 0;
   std::uint64_t solves = 0;  // LPs solved (one per vertex, the zero-utilisation variants).
   std::uint64_t pivots = 0;  // Their simplex pivots.
+  int first_vertex = 0;      // first_failure_suffices: where the next vertex loop starts.
+
+  // The i-th vertex a loop over `count` visits: all of them in order, or, when the first failure
+  // suffices, starting where the last failure was (the next question is often like the last).
+  int VertexAt(int i, int count) const {
+    return options.first_failure_suffices ? (first_vertex + i) % count : i;
+  }
+  // After vertex v failed: true when the loop may stop there.
+  bool StopAfterFailure(int v) {
+    if (!options.first_failure_suffices) return false;
+    first_vertex = v;
+    return true;
+  }
 
   // The backend's answer, or Clp's when the dense simplex ends without one (infeasible, an
   // iteration limit, an error) on an LP that has an answer by construction (x = 0, s = 0 is
@@ -341,7 +354,8 @@ Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config
   const double s_feasible = 1.0 - options.tolerance;
   double worst = -1.0;
   lp->LoadBase(problem, n);
-  for (int v = 0; v < vertices.count; ++v) {
+  for (int i = 0; i < vertices.count; ++i) {
+    const int v = VertexAt(i, vertices.count);
     const double* w = vertices.vertex(v);
     std::copy(w, w + rows, problem.column(n));  // The zero-utilisation variant starts from it.
     LpStatus status = SolveVarying(problem, w);
@@ -364,6 +378,11 @@ Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config
     if (utilisation > worst) {
       worst = utilisation;
       out.worst_vertex = v;
+    }
+    if (failing && StopAfterFailure(v)) {
+      out.worst_vertex = v;  // the vertex the reason explains
+      worst = utilisation;
+      break;
     }
   }
   out.utilisation = worst < 0.0 ? 0.0 : worst;
@@ -478,7 +497,8 @@ Result<std::vector<double>> WrenchChecker::Impl::SolveMatingVertices(
   std::vector<double> total(n), hold(n);
   std::vector<double> worst_hold;
   double worst = -1.0;
-  for (int v = 0; v < vertices.count; ++v) {
+  for (int i = 0; i < vertices.count; ++i) {
+    const int v = VertexAt(i, vertices.count);
     const double* w = vertices.vertex(v);
     std::copy(w, w + nb6, joint.column(s_col) + nb6);
     std::fill(joint.column(s_col), joint.column(s_col) + nb6, 0.0);
@@ -517,11 +537,12 @@ Result<std::vector<double>> WrenchChecker::Impl::SolveMatingVertices(
       for (int j = 0; j < n; ++j) hold[j] = solution.x[j];
     }
     if (failing) ++out.failing_vertex_count;
-    if (utilisation > worst) {
+    if (utilisation > worst || (failing && options.first_failure_suffices)) {
       worst = utilisation;
       out.worst_vertex = v;
       worst_hold = hold;
     }
+    if (failing && StopAfterFailure(v)) break;
   }
   out.utilisation = worst < 0.0 ? hold_utilisation : worst;
   return worst_hold;

@@ -170,6 +170,11 @@ struct WrenchOptions {
   bool explain = true;      ///< When infeasible, solve a minimum-violation LP to name the binding
                             ///< limits (costs one more LP on the failing path only).
   double tolerance = 1e-7;  ///< Feasible when the load factor is >= 1 - tolerance.
+  /// Stop at the first vertex that fails: `feasible` and the reason (that vertex's) are exact,
+  /// but `utilisation`, `worst_vertex`, `failing_vertex_count` and the support loads cover only
+  /// the vertices checked. Each check then starts at the vertex that failed last (the planner's
+  /// questions come in runs of similar configurations). For searches that need a yes or no.
+  bool first_failure_suffices = false;
   std::size_t cache_capacity = 1 << 16;  ///< Cached answers kept; the cache is emptied when full.
 };
 
@@ -213,7 +218,8 @@ struct WrenchCheck {
   /// supports (the table) carry it.
   double utilisation = 0.0;
   int vertex_count = 0;               ///< Vertices of U checked (0 in mode kNone).
-  int failing_vertex_count = 0;       ///< Vertices that are not balanced.
+  int failing_vertex_count = 0;       ///< Vertices that are not balanced (at least one, and the
+                                      ///< rest not counted, with first_failure_suffices).
   int worst_vertex = -1;              ///< Vertex with the largest utilisation (0-based).
   std::string worst_vertex_label;     ///< Its description, e.g. "transverse +x, offset -y".
   std::vector<SupportLoad> supports;  ///< Grippers, then connections, then tables, in order

@@ -299,6 +299,40 @@ TEST(WrenchVacuum, AssemblyModeRejectsTransverseMatingForce) {
   EXPECT_NE(transverse.reason.find("(3 more of the 4 vertices fail)"), std::string::npos);
 }
 
+// A search needs a yes or no: with first_failure_suffices the check stops at the first failing
+// vertex, gives the same verdict and explains that vertex; the next check starts there. A check
+// that passes still solves every vertex.
+TEST(WrenchVacuum, FirstFailureSufficesGivesTheSameVerdictWithFewerLps) {
+  StepConfiguration c = CupPegIntoHeldSeat(0.0);
+  c.mating->transverse_fraction = 0.1;
+  WrenchChecker full(WrenchOptions{});
+  WrenchChecker first(WrenchOptions{.first_failure_suffices = true});
+  const Result<WrenchCheck> all = full.Check(c, {});
+  const Result<WrenchCheck> one = first.Check(c, {});
+  ASSERT_TRUE(all && one);
+  EXPECT_FALSE(all->feasible);
+  EXPECT_FALSE(one->feasible);
+  EXPECT_EQ(all->failing_vertex_count, 4);
+  EXPECT_EQ(one->failing_vertex_count, 1);
+  EXPECT_EQ(one->worst_vertex, 0);
+  EXPECT_NE(one->reason.find("assembly: vertex 1/4 (transverse +x -y): the vacuum gripper 'r1' on "
+                             "'peg' would need 1 N along"),
+            std::string::npos)
+      << one->reason;
+  EXPECT_EQ(one->reason.find("more of the"), std::string::npos) << one->reason;
+  EXPECT_LT(first.lp_solves(), full.lp_solves());
+
+  // The axial insertion passes: every vertex is solved, the answer as without the option.
+  c.mating->transverse_fraction = 0.0;
+  const std::uint64_t before = first.lp_solves();
+  const Result<WrenchCheck> pass = first.Check(c, {});
+  const Result<WrenchCheck> reference = full.Check(c, {});
+  ASSERT_TRUE(pass && reference);
+  EXPECT_TRUE(pass->feasible);
+  EXPECT_EQ(pass->utilisation, reference->utilisation);
+  EXPECT_EQ(first.lp_solves() - before, static_cast<std::uint64_t>(reference->vertex_count) + 1);
+}
+
 // top (held) -- compression-only connection -- bottom <- peg inserted along the axis. The
 // connection frame's z points from top into bottom (down): top pressing bottom down is
 // compression, top pulling it up is tension.
@@ -733,7 +767,8 @@ TEST(WrenchRelaxation, NeverRefusesWhatSomeOrientationHolds) {
   int held = 0, refused_by_relaxation = 0;
   for (int trial = 0; trial < 150; ++trial) {
     StepConfiguration c;
-    c.bodies.push_back({"moved", 0.2 + 0.8 * (u(rng) + 1.0), Vec3(0.05 * u(rng), 0.05 * u(rng), 0.15)});
+    c.bodies.push_back(
+        {"moved", 0.2 + 0.8 * (u(rng) + 1.0), Vec3(0.05 * u(rng), 0.05 * u(rng), 0.15)});
     c.bodies.push_back({"base", 0.5 + (u(rng) + 1.0), Vec3(0.05 * u(rng), 0.05 * u(rng), 0.0)});
     for (int b = 0; b < 2; ++b) {
       const bool cup = b == 0 || u(rng) > 0.3;
