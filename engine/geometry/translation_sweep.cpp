@@ -73,59 +73,73 @@ TravelInterval TriangleTravelInterval(const std::array<Vec3, 3>& a, const std::a
 
 SweepMesh::SweepMesh(const TriangleMesh& mesh, const Iso3& X_FM) {
   const int n = static_cast<int>(mesh.triangles.size());
+  if (n == 0) return;
   std::vector<Triangle> placed(n);
-  std::vector<Vec3> centroids(n);
+  BuildInput in;
+  in.lo.resize(n);
+  in.hi.resize(n);
+  in.centroid.resize(n);
   for (int i = 0; i < n; ++i) {
-    for (int k = 0; k < 3; ++k) placed[i].v[k] = X_FM * mesh.vertices[mesh.triangles[i][k]];
-    centroids[i] = (placed[i].v[0] + placed[i].v[1] + placed[i].v[2]) / 3.0;
+    Triangle& t = placed[i];
+    for (int k = 0; k < 3; ++k) t.v[k] = X_FM * mesh.vertices[mesh.triangles[i][k]];
+    in.lo[i] = t.v[0].cwiseMin(t.v[1]).cwiseMin(t.v[2]);
+    in.hi[i] = t.v[0].cwiseMax(t.v[1]).cwiseMax(t.v[2]);
+    in.centroid[i] = (t.v[0] + t.v[1] + t.v[2]) / 3.0;
   }
   index_.resize(n);
   for (int i = 0; i < n; ++i) index_[i] = i;
-  if (n == 0) return;
-  triangles_ = std::move(placed);  // Build reads the triangles by mesh index
   nodes_.reserve(2 * n);
   nodes_.emplace_back();
-  Build(0, 0, n, centroids);
-  // Store the triangles in leaf order, so that a leaf's triangles lie side by side.
-  std::vector<Triangle> ordered(n);
-  for (int s = 0; s < n; ++s) ordered[s] = triangles_[index_[s]];
-  triangles_ = std::move(ordered);
+  Build(0, 0, n, in);
+  // The triangles in leaf order, so that a leaf's triangles lie side by side.
+  triangles_.resize(n);
+  for (int s = 0; s < n; ++s) triangles_[s] = placed[index_[s]];
 }
 
-void SweepMesh::Build(int node, int begin, int end, std::vector<Vec3>& centroids) {
-  Vec3 lo = Vec3::Constant(kInf), hi = Vec3::Constant(-kInf);
-  Vec3 c_lo = lo, c_hi = hi;
-  for (int s = begin; s < end; ++s) {
-    const Triangle& t = triangles_[index_[s]];
-    for (const Vec3& v : t.v) {
-      lo = lo.cwiseMin(v);
-      hi = hi.cwiseMax(v);
-    }
-    c_lo = c_lo.cwiseMin(centroids[index_[s]]);
-    c_hi = c_hi.cwiseMax(centroids[index_[s]]);
-  }
-  nodes_[node].lo = lo.array() - kBoxPad_m;
-  nodes_[node].hi = hi.array() + kBoxPad_m;
+void SweepMesh::Build(int node, int begin, int end, const BuildInput& in) {
   if (end - begin <= kLeafSize) {
+    Vec3 lo = Vec3::Constant(kInf), hi = Vec3::Constant(-kInf);
+    for (int s = begin; s < end; ++s) {
+      lo = lo.cwiseMin(in.lo[index_[s]]);
+      hi = hi.cwiseMax(in.hi[index_[s]]);
+    }
+    nodes_[node].lo = lo.array() - kBoxPad_m;
+    nodes_[node].hi = hi.array() + kBoxPad_m;
     nodes_[node].first = begin;
     nodes_[node].count = end - begin;
     return;
   }
-  // Median split along the longest extent of the centroids (ties by index: deterministic).
+  // Split at the middle of the centroids' longest extent (one pass); where that leaves a side
+  // nearly empty, at their median instead (ties by index: deterministic either way).
+  Vec3 c_lo = Vec3::Constant(kInf), c_hi = Vec3::Constant(-kInf);
+  for (int s = begin; s < end; ++s) {
+    c_lo = c_lo.cwiseMin(in.centroid[index_[s]]);
+    c_hi = c_hi.cwiseMax(in.centroid[index_[s]]);
+  }
   int axis = 0;
   (c_hi - c_lo).maxCoeff(&axis);
-  const int mid = (begin + end) / 2;
-  std::nth_element(index_.begin() + begin, index_.begin() + mid, index_.begin() + end,
-                   [&](int i, int j) {
-                     const double ci = centroids[i][axis], cj = centroids[j][axis];
-                     return ci < cj || (ci == cj && i < j);
-                   });
+  const double middle = 0.5 * (c_lo[axis] + c_hi[axis]);
+  const auto split = std::partition(index_.begin() + begin, index_.begin() + end,
+                                    [&](int i) { return in.centroid[i][axis] < middle; });
+  int mid = static_cast<int>(split - index_.begin());
+  const int least = (end - begin) / 8;
+  if (mid - begin <= least || end - mid <= least) {
+    mid = (begin + end) / 2;
+    std::nth_element(index_.begin() + begin, index_.begin() + mid, index_.begin() + end,
+                     [&](int i, int j) {
+                       const double ci = in.centroid[i][axis], cj = in.centroid[j][axis];
+                       return ci < cj || (ci == cj && i < j);
+                     });
+  }
   const int first = static_cast<int>(nodes_.size());
   nodes_[node].first = first;
   nodes_.emplace_back();
   nodes_.emplace_back();
-  Build(first, begin, mid, centroids);
-  Build(first + 1, mid, end, centroids);
+  Build(first, begin, mid, in);
+  Build(first + 1, mid, end, in);
+  // An inner box is the union of its children's (already padded).
+  nodes_[node].lo = nodes_[first].lo.cwiseMin(nodes_[first + 1].lo);
+  nodes_[node].hi = nodes_[first].hi.cwiseMax(nodes_[first + 1].hi);
 }
 
 Aabb SweepMesh::box() const {

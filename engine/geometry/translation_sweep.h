@@ -31,7 +31,8 @@ TravelInterval TriangleTravelInterval(const std::array<Vec3, 3>& a, const std::a
 /// triangles, ready for SweepContact. Immutable after construction: share it between threads.
 class SweepMesh {
  public:
-  /// `mesh` mapped through X_FM (mesh frame M to F). Median splits, up to 4 triangles a leaf.
+  /// `mesh` mapped through X_FM (mesh frame M to F). Splits at the middle of the longest
+  /// extent (or the median), up to 2 triangles a leaf.
   SweepMesh(const TriangleMesh& mesh, const Iso3& X_FM);
 
   /// Number of triangles.
@@ -53,7 +54,10 @@ class SweepMesh {
                      // triangle slot for a leaf
     int count = 0;   // triangles in a leaf, 0 for an inner node
   };
-  void Build(int node, int begin, int end, std::vector<Vec3>& centroids);
+  struct BuildInput {  // per triangle (mesh index): its box and centroid in F
+    std::vector<Vec3> lo, hi, centroid;
+  };
+  void Build(int node, int begin, int end, const BuildInput& in);
 
   std::vector<Triangle> triangles_;  // in leaf order
   std::vector<int> index_;           // the mesh's triangle index of each slot
