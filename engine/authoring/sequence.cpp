@@ -13,14 +13,10 @@ namespace wrap {
 
 namespace {
 
-// The sweeps of the search over directions step at least this far (validation sweeps the
-// chosen axis again at 0.1 mm) [m].
-constexpr double kSearchStep_m = 5e-4;
-
 // One way to take a unit off the rest.
 struct Removal {
-  std::vector<int> unit;  // the parts taken off (ascending)
-  std::vector<int> rest;  // what stays
+  std::vector<int> unit;       // the parts taken off (ascending)
+  std::vector<int> rest;       // what stays
   Vec3 axis = -Vec3::UnitZ();  // the insertion axis: the unit comes back in along it
   int grasps = 0;
   double rank[6] = {0, 0, 0, 0, 0, 0};  // larger is better, compared in order
@@ -53,7 +49,8 @@ bool Connected(const ContactGraph& graph, const std::vector<int>& parts) {
 
 // How far the unit must travel to clear the rest in any direction: the diagonal of their joint
 // box, plus a centimetre.
-double ClearLength(AssemblyGeometry& g, const std::vector<int>& unit, const std::vector<int>& rest) {
+double ClearLength(AssemblyGeometry& g, const std::vector<int>& unit,
+                   const std::vector<int>& rest) {
   Vec3 lo = Vec3::Constant(1e9), hi = -lo;
   for (const std::vector<int>* set : {&unit, &rest}) {
     for (int p : *set) {
@@ -88,7 +85,6 @@ std::optional<Vec3> BestFreeAxis(AssemblyGeometry& g, const ContactGraph& graph,
   path.base = rest;
   path.length_m = ClearLength(g, unit, rest);
   path.touch_depth_m = options.touch_depth_m;
-  path.min_step_m = kSearchStep_m;
   // Axes and contact normals first; the sphere only when none of them is free.
   for (int sphere : {0, options.sphere}) {
     const std::vector<Vec3> free = FreeAxes(g, path, CandidateAxes(graph, unit, rest, sphere));
@@ -191,24 +187,25 @@ std::optional<ProposedStep> PairStep(AssemblyGeometry& g, const ContactGraph& gr
 void AssignRoles(AssemblyGeometry& g, GraspProbe* probe, const SequenceOptions& options,
                  ProposedStep& s) {
   s.base_grasps = ClearGrasps(probe, options.end_effector, s.base, s.moved);
-  s.why = Names(g, s.moved) + " onto " + Names(g, s.base) + " along " +
-          FormatDirection(s.axis_A) + " (" +
-          std::to_string(s.moved_grasps) + " grasps clear of the base where mated)";
+  s.why = Names(g, s.moved) + " onto " + Names(g, s.base) + " along " + FormatDirection(s.axis_A) +
+          " (" + std::to_string(s.moved_grasps) + " grasps clear of the base where mated)";
   if (probe != nullptr && s.moved_grasps == 0 && s.base_grasps > 0) {
     std::swap(s.moved, s.base);
     std::swap(s.moved_grasps, s.base_grasps);
     s.axis_A = -s.axis_A;
     s.swapped = true;
     s.why = Names(g, s.moved) + " onto " + Names(g, s.base) + " along " +
-            FormatDirection(s.axis_A) + " (roles swapped: no grasp of the other input clears it "
-            "where mated, " + std::to_string(s.moved_grasps) + " of this one do)";
+            FormatDirection(s.axis_A) +
+            " (roles swapped: no grasp of the other input clears it "
+            "where mated, " +
+            std::to_string(s.moved_grasps) + " of this one do)";
   }
 }
 
 }  // namespace
 
-ProposedSequence ProposeSequence(AssemblyGeometry& g, const ContactGraph& graph,
-                                 GraspProbe* probe, const SequenceOptions& options) {
+ProposedSequence ProposeSequence(AssemblyGeometry& g, const ContactGraph& graph, GraspProbe* probe,
+                                 const SequenceOptions& options) {
   ProposedSequence out;
   std::vector<int> remaining;
   for (int p = 0; p < g.num_parts(); ++p) {

@@ -17,8 +17,8 @@ constexpr double kSampleSpacing_m = 1e-3;
 
 }  // namespace
 
-AssemblyGeometry::AssemblyGeometry(std::vector<std::string> names,
-                                   std::vector<TriangleMesh> meshes, std::vector<Iso3> X_AP)
+AssemblyGeometry::AssemblyGeometry(std::vector<std::string> names, std::vector<TriangleMesh> meshes,
+                                   std::vector<Iso3> X_AP)
     : names_(std::move(names)), meshes_(std::move(meshes)), X_AP_(std::move(X_AP)) {
   queries_.resize(names_.size());
   samples_.resize(names_.size());
@@ -67,6 +67,21 @@ const std::vector<Vec3>& AssemblyGeometry::samples(int part) {
   return out;
 }
 
+const TriangleMesh& AssemblyGeometry::inset_mesh(int part, double inset_m) {
+  const long long depth_nm = std::llround(inset_m * 1e9);
+  if (depth_nm == 0) return meshes_[part];
+  std::unique_ptr<TriangleMesh>& slot = inset_meshes_[{depth_nm, part}];
+  if (!slot) slot = std::make_unique<TriangleMesh>(InsetMesh(meshes_[part], inset_m));
+  return *slot;
+}
+
+const SweepMesh& AssemblyGeometry::sweep_mesh(int part, double inset_m) {
+  const long long depth_nm = std::llround(inset_m * 1e9);
+  std::unique_ptr<SweepMesh>& slot = sweep_meshes_[{depth_nm, part}];
+  if (!slot) slot = std::make_unique<SweepMesh>(inset_mesh(part, inset_m), X_AP_[part]);
+  return *slot;
+}
+
 CollisionWorld& AssemblyGeometry::world(double inset_m) {
   const long long key = std::llround(inset_m * 1e9);
   auto it = worlds_.find(key);
@@ -79,7 +94,7 @@ CollisionWorld& AssemblyGeometry::world(double inset_m) {
     if (!meshes_[p].empty()) {
       Shape shape;
       shape.type = Shape::Type::kMesh;
-      shape.mesh = inset_m == 0.0 ? meshes_[p] : InsetMesh(meshes_[p], inset_m);
+      shape.mesh = inset_mesh(p, inset_m);
       shape.name = names_[p];
       def.shapes.push_back(std::move(shape));
     }

@@ -1,6 +1,6 @@
 // The parts of an assembly as the geometry checks see them: each part's mesh and assembled pose,
 // and what the checks derive from a mesh on demand (a query structure, surface samples, inward
-// offsets, a collision world of all parts).
+// offsets, box trees for exact sweeps, a collision world of all parts).
 #pragma once
 
 #include <map>
@@ -12,6 +12,7 @@
 #include "core/pose.h"
 #include "geometry/mesh.h"
 #include "geometry/mesh_query.h"
+#include "geometry/translation_sweep.h"
 #include "model/project.h"
 #include "model/validate.h"
 #include "robot/collision.h"
@@ -47,6 +48,12 @@ class AssemblyGeometry {
   /// about one per `spacing` squared of area, at least 500 and at most 6000.
   const std::vector<Vec3>& samples(int part);
 
+  /// The part's mesh moved inward by `inset_m` (0: the mesh itself), part frame. Cached by depth.
+  const TriangleMesh& inset_mesh(int part, double inset_m);
+  /// The part's mesh moved inward by `inset_m` at its assembled pose, frame A, with its box tree
+  /// for SweepContact. Cached by depth.
+  const SweepMesh& sweep_mesh(int part, double inset_m);
+
   /// A world whose body i is part i moved inward by `inset_m` (0: the mesh itself), every body at
   /// its assembled pose when first built. Parts without a mesh have no shapes. Cached by depth.
   CollisionWorld& world(double inset_m);
@@ -57,6 +64,9 @@ class AssemblyGeometry {
   std::vector<Iso3> X_AP_;
   std::vector<std::unique_ptr<MeshQuery>> queries_;
   std::vector<std::vector<Vec3>> samples_;
+  // By inset in nanometres, then part.
+  std::map<std::pair<long long, int>, std::unique_ptr<TriangleMesh>> inset_meshes_;
+  std::map<std::pair<long long, int>, std::unique_ptr<SweepMesh>> sweep_meshes_;
   std::map<long long, std::unique_ptr<CollisionWorld>> worlds_;  // by inset in nanometres
 };
 

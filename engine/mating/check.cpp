@@ -1,8 +1,8 @@
 #include "mating/check.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <algorithm>
 #include <cstdio>
 
 namespace wrap {
@@ -48,8 +48,8 @@ void ReportTouch(const Project& project, const AssemblyTree& tree, const Assembl
                     Quote(base.name) + " do not touch at the mating pose (closest " +
                     FormatMm(sg.inputs.distance_m);
   if (sg.inputs.part_a >= 0 && (moved.parts.size() > 1 || base.parts.size() > 1)) {
-    msg += ", between " + Quote(g.name(sg.inputs.part_a)) + " and " +
-           Quote(g.name(sg.inputs.part_b));
+    msg +=
+        ", between " + Quote(g.name(sg.inputs.part_a)) + " and " + Quote(g.name(sg.inputs.part_b));
   }
   msg += "; surfaces within " + FormatMm(graph.tolerance_m) + " touch); " + Quote(moved.name);
   const std::string touched = TouchedNames(g, graph, moved.parts);
@@ -58,8 +58,7 @@ void ReportTouch(const Project& project, const AssemblyTree& tree, const Assembl
 }
 
 void ReportPaths(const Project& project, const AssemblyTree& tree, const AssemblyGeometry& g,
-                 const std::string& file, const StepGeometry& sg, int sphere,
-                 Diagnostics& diags) {
+                 const std::string& file, const StepGeometry& sg, int sphere, Diagnostics& diags) {
   const Step& step = project.steps[sg.step];
   const Mating& m = step.mating;
   const AssemblyNode& moved = tree.nodes[sg.moved];
@@ -81,7 +80,8 @@ void ReportPaths(const Project& project, const AssemblyTree& tree, const Assembl
     }
     if (sg.free_axes.empty()) {
       msg += "; no free direction among the axes, the contact normals and " +
-             std::to_string(sphere) + " sampled directions (interlocked, or overlapping where "
+             std::to_string(sphere) +
+             " sampled directions (interlocked, or overlapping where "
              "they are mated)";
     } else {
       msg += "; free directions: ";
@@ -117,11 +117,10 @@ StepGeometry CheckStep(const Project& project, const AssemblyTree& tree, Assembl
     const InsertionPath path = StepInsertionPath(project, tree, s, m.final_poses.empty() ? -1 : k);
     sg.paths.push_back(SweepInsertion(g, path, &sg.stats));
   }
-  sg.sweep_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                    .count();
+  sg.sweep_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (sg.blocked()) {
-    InsertionPath path = StepInsertionPath(project, tree, s, -1);
-    path.min_step_m = 5e-4;  // a search over many directions: coarser steps
+    const InsertionPath path = StepInsertionPath(project, tree, s, -1);
     sg.free_axes = FreeAxes(g, path, CandidateAxes(graph, moved, base, options.sphere_axes));
   }
   return sg;
@@ -178,8 +177,7 @@ InsertionPath StepInsertionPath(const Project& project, const AssemblyTree& tree
 }
 
 GeometryReport CheckAssemblyGeometry(const Project& project, const ProjectCheck& check,
-                                     const std::string& file,
-                                     const GeometryCheckOptions& options) {
+                                     const std::string& file, const GeometryCheckOptions& options) {
   GeometryReport report;
   AssemblyGeometry g = AssemblyGeometry::FromProject(project, check);
   ContactOptions contact_options;
@@ -199,10 +197,10 @@ GeometryReport CheckAssemblyGeometry(const Project& project, const ProjectCheck&
     for (const Part& part : project.parts) X_WP.push_back(ToIsometry(part.initial_pose));
     report.start_overlaps = StartOverlaps(g, X_WP, project.geometry.touch_depth_m);
     for (const StartOverlap& o : report.start_overlaps) {
-      report.diagnostics.Error(
-          file, "parts[" + std::to_string(o.b) + "].initial_pose",
-          "part " + Quote(g.name(o.b)) + " overlaps part " + Quote(g.name(o.a)) + " by " +
-              FormatMm(o.depth_m) + " where they start on the table");
+      report.diagnostics.Error(file, "parts[" + std::to_string(o.b) + "].initial_pose",
+                               "part " + Quote(g.name(o.b)) + " overlaps part " +
+                                   Quote(g.name(o.a)) + " by " + FormatMm(o.depth_m) +
+                                   " where they start on the table");
     }
   }
   return report;

@@ -25,26 +25,26 @@ struct GeometryCheckOptions {
 
 /// What the geometry says of one step.
 struct StepGeometry {
-  int step = -1;                  ///< Index into Project::steps.
-  int moved = -1;                 ///< Node id of the moved input.
-  int base = -1;                  ///< Node id of the base input.
-  SetDistance inputs;             ///< Closest approach of the inputs at the mating pose.
-  bool touch = false;             ///< The inputs touch (within the contact tolerance).
-  std::vector<PathHit> paths;     ///< One per final pose (the assembled pose when none given).
-  std::vector<Vec3> free_axes;    ///< Free insertion axes, searched when a path is blocked.
-  double sweep_ms = 0.0;          ///< Time the declared paths' sweeps took [ms].
-  SweepStats stats;               ///< Their poses and pair tests.
-  bool blocked() const;           ///< Some declared path is blocked.
+  int step = -1;                ///< Index into Project::steps.
+  int moved = -1;               ///< Node id of the moved input.
+  int base = -1;                ///< Node id of the base input.
+  SetDistance inputs;           ///< Closest approach of the inputs at the mating pose.
+  bool touch = false;           ///< The inputs touch (within the contact tolerance).
+  std::vector<PathHit> paths;   ///< One per final pose (the assembled pose when none given).
+  std::vector<Vec3> free_axes;  ///< Free insertion axes, searched when a path is blocked.
+  double sweep_ms = 0.0;        ///< Time the declared paths' sweeps took [ms].
+  SweepStats stats;             ///< Their part pairs, box and triangle tests.
+  bool blocked() const;         ///< Some declared path is blocked.
 };
 
 /// Everything CheckAssemblyGeometry found.
 struct GeometryReport {
-  ContactGraph contacts;                    ///< Which parts touch, assembled.
-  std::vector<StepGeometry> steps;          ///< One per step of the project (when the DAG is
-                                            ///< well formed and the meshes loaded).
-  std::vector<StartOverlap> start_overlaps; ///< Parts that overlap where they start.
-  Diagnostics diagnostics;                  ///< Errors for each problem above, naming the
-                                            ///< step or part, the parts and the distances.
+  ContactGraph contacts;                     ///< Which parts touch, assembled.
+  std::vector<StepGeometry> steps;           ///< One per step of the project (when the DAG is
+                                             ///< well formed and the meshes loaded).
+  std::vector<StartOverlap> start_overlaps;  ///< Parts that overlap where they start.
+  Diagnostics diagnostics;                   ///< Errors for each problem above, naming the
+                                             ///< step or part, the parts and the distances.
 };
 
 /// Judges the project's geometry (see GeometryReport). Needs the meshes and the DAG from

@@ -4,117 +4,80 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 
 namespace wrap {
 
 namespace {
 
 constexpr double kSameAxisCos = 0.99863;  // cos 3 deg
-constexpr double kNear_m = 2e-3;          // nearer than this the sweep takes fixed steps
-constexpr int kDistanceEvery = 16;        // ... with a distance every so many
+// The far range starts this much beyond the interference band: a contact exactly at its edge
+// belongs to the band [m].
+constexpr double kBandEdge_m = 1e-9;
 
 // The world whose meshes are inset so that an intersection means more than `allowed` overlap.
 CollisionWorld& WorldFor(AssemblyGeometry& g, double allowed_overlap_m) {
   return g.world(0.5 * allowed_overlap_m);
 }
 
-// Overlap allowed at `s` back from the mating pose.
-double AllowedAt(const InsertionPath& path, double s) {
-  const double band = path.interference_travel_m;
-  return s <= band + 1e-12 ? std::max(path.interference_depth_m, path.touch_depth_m)
-                           : path.touch_depth_m;
-}
-
-// Poses the moved parts at `s` in `world` and returns the least distance between the moved and
-// the base parts (0 at an overlap, then `hit` names the pair).
-double PoseAndMeasure(AssemblyGeometry& g, CollisionWorld& world, const InsertionPath& path,
-                      double s, double horizon, PathHit* hit, SweepStats* stats) {
-  for (int p : path.moved) world.SetPose(BodyId{p}, PathPose(g, path, p, s));
-  for (int p : path.base) world.SetPose(BodyId{p}, g.X_AP(p));
-  if (stats) ++stats->poses;
-  double least = horizon;
-  for (int m : path.moved) {
-    if (!g.has_mesh(m)) continue;
-    for (int b : path.base) {
-      if (!g.has_mesh(b)) continue;
-      DistanceRequest request;
-      request.nearest_points = false;
-      request.upper_bound_m = least;
-      const DistanceResult d = world.Distance(BodyId{m}, BodyId{b}, request);
-      if (stats) stats->pair_tests += d.narrowphase_tests > 0 ? 1 : 0;
-      if (!d.has_pair() || d.distance >= least) continue;
-      least = d.distance;
-      if (least <= 0.0) {
-        hit->blocked = true;
-        hit->at_m = s;
-        hit->moved_part = m;
-        hit->base_part = b;
-        return 0.0;
-      }
-    }
-  }
-  return least;
-}
-
-// Poses the moved parts at `s` and asks FCL whether any moved part overlaps a base part (exact,
-// with early exit: cheaper than a distance when the surfaces slide along each other).
-bool PoseAndCollide(AssemblyGeometry& g, CollisionWorld& world, const InsertionPath& path,
-                    double s, PathHit* hit, SweepStats* stats) {
-  for (int p : path.moved) world.SetPose(BodyId{p}, PathPose(g, path, p, s));
-  for (int p : path.base) world.SetPose(BodyId{p}, g.X_AP(p));
-  if (stats) ++stats->poses;
-  for (int m : path.moved) {
-    if (!g.has_mesh(m)) continue;
-    const Aabb box_m = world.body_aabb(BodyId{m});
-    for (int b : path.base) {
-      if (!g.has_mesh(b)) continue;
-      const Aabb box_b = world.body_aabb(BodyId{b});
-      if ((box_m.max.array() < box_b.min.array()).any() ||
-          (box_b.max.array() < box_m.min.array()).any()) {
-        continue;
-      }
-      if (stats) ++stats->pair_tests;
-      if (world.Collide(BodyId{m}, BodyId{b})) {
-        hit->blocked = true;
-        hit->at_m = s;
-        hit->moved_part = m;
-        hit->base_part = b;
-        return true;
-      }
-    }
-  }
-  return false;
-}
-
-// Sweeps s from `from` to `to` (either way), stopping at the first overlap. Far from the base,
-// conservative advancement: each step is the distance the meshes are apart. Within kNear_m of
-// it (the surfaces sliding along each other), fixed steps of path.min_step_m with FCL's
-// collision test, and a distance now and then to see whether the input has got clear.
-PathHit Sweep(AssemblyGeometry& g, const InsertionPath& path, double from, double to,
-              SweepStats* stats) {
+// The first (or, with `last`, the last) s in [s_lo, s_hi] at which the moved parts, on their
+// meshes inset by half of `allowed_m`, meet the base parts: one exact sweep per pair of parts
+// (SweepContact), each bounded by the best contact found before it.
+PathHit SweepRange(AssemblyGeometry& g, const InsertionPath& path, double allowed_m, double s_lo,
+                   double s_hi, bool last, SweepStats* stats) {
   PathHit hit;
-  const double sign = to >= from ? 1.0 : -1.0;
-  const double band = path.interference_travel_m;
-  double s = from;
-  int near_steps = -1;  // fixed steps since the last distance; -1: far
-  for (;;) {
-    CollisionWorld& world = WorldFor(g, AllowedAt(path, s));
-    const double remaining = std::abs(to - s);
-    double step = path.min_step_m;
-    if (near_steps < 0 || near_steps >= kDistanceEvery) {
-      const double d = PoseAndMeasure(g, world, path, s, remaining + 1e-3, &hit, stats);
-      if (hit.blocked || remaining <= 0.0) return hit;
-      near_steps = d > kNear_m ? -1 : 0;
-      step = std::max(d, path.min_step_m);
-    } else {
-      if (PoseAndCollide(g, world, path, s, &hit, stats) || remaining <= 0.0) return hit;
-      ++near_steps;
+  if (!(s_lo <= s_hi)) return hit;
+  const double inset = 0.5 * allowed_m;
+  // The moved input at s is at its mating pose moved by -s along the axis: t = s, d = -axis.
+  SweepQuery query;
+  query.d_F = -path.axis_A;
+  query.t_min = s_lo;
+  query.t_max = s_hi;
+  query.last = last;
+  const bool in_place = path.X_BM.matrix() == Iso3::Identity().matrix();
+  SweepContactStats work;
+  for (int m : path.moved) {
+    if (!g.has_mesh(m)) continue;
+    // The cached tree is at the assembled pose; another final pose needs its own.
+    std::optional<SweepMesh> own;
+    if (!in_place) own.emplace(g.inset_mesh(m, inset), path.X_BM * g.X_AP(m));
+    const SweepMesh& moving = in_place ? g.sweep_mesh(m, inset) : *own;
+    for (int b : path.base) {
+      if (!g.has_mesh(b)) continue;
+      if (stats) ++stats->part_pairs;
+      const auto c = SweepContact(moving, g.sweep_mesh(b, inset), query, &work);
+      if (!c) continue;
+      if (hit.blocked && (last ? c->t <= hit.at_m : c->t >= hit.at_m)) continue;
+      hit.blocked = true;
+      hit.at_m = c->t;
+      hit.moved_part = m;
+      hit.base_part = b;
+      (last ? query.t_min : query.t_max) = c->t;
     }
-    // Do not step over the edge of the interference band: the allowance changes there.
-    if ((s - band) * (s + sign * step - band) < 0.0) step = std::abs(band - s);
-    if (step <= 0.0) step = path.min_step_m;
-    s = sign > 0 ? std::min(to, s + step) : std::max(to, s - step);
   }
+  if (stats) {
+    stats->box_tests += work.box_tests;
+    stats->triangle_tests += work.triangle_tests;
+  }
+  return hit;
+}
+
+// The path's contact nearest the start (`last`: coming in from length_m, the largest s) or
+// nearest the mating pose (the smallest s). The last interference_travel_m before the mating pose
+// allow the band's overlap, the rest touch_depth_m: two inset meshes over two ranges of s.
+PathHit Sweep(AssemblyGeometry& g, const InsertionPath& path, bool last, SweepStats* stats) {
+  const double length = std::max(0.0, path.length_m);
+  const double band = std::clamp(path.interference_travel_m, 0.0, length);
+  const double band_allowed = std::max(path.interference_depth_m, path.touch_depth_m);
+  if (band_allowed == path.touch_depth_m) {
+    return SweepRange(g, path, band_allowed, 0.0, length, last, stats);
+  }
+  const auto near = [&] { return SweepRange(g, path, band_allowed, 0.0, band, last, stats); };
+  const auto far = [&] {
+    return SweepRange(g, path, path.touch_depth_m, band + kBandEdge_m, length, last, stats);
+  };
+  const PathHit first = last ? far() : near();
+  return first.blocked ? first : (last ? near() : far());
 }
 
 }  // namespace
@@ -126,11 +89,11 @@ Iso3 PathPose(const AssemblyGeometry& g, const InsertionPath& path, int part, do
 }
 
 PathHit SweepInsertion(AssemblyGeometry& g, const InsertionPath& path, SweepStats* stats) {
-  return Sweep(g, path, std::max(0.0, path.length_m), 0.0, stats);
+  return Sweep(g, path, true, stats);
 }
 
 bool IsPathFree(AssemblyGeometry& g, const InsertionPath& path, PathHit* hit, SweepStats* stats) {
-  const PathHit h = Sweep(g, path, 0.0, std::max(0.0, path.length_m), stats);
+  const PathHit h = Sweep(g, path, false, stats);
   if (hit) *hit = h;
   return !h.blocked;
 }
@@ -180,8 +143,8 @@ std::vector<Vec3> FreeAxes(AssemblyGeometry& g, InsertionPath path,
 }
 
 std::optional<PartOverlap> OverlapBeyond(AssemblyGeometry& g, const std::vector<int>& set_a,
-                                         const std::vector<int>& set_b,
-                                         const std::vector<Iso3>& X, double allowed_m) {
+                                         const std::vector<int>& set_b, const std::vector<Iso3>& X,
+                                         double allowed_m) {
   CollisionWorld& world = WorldFor(g, allowed_m);
   for (int p : set_a) world.SetPose(BodyId{p}, X[p]);
   for (int p : set_b) world.SetPose(BodyId{p}, X[p]);

@@ -15,18 +15,15 @@ namespace wrap {
 /// One insertion to judge: the moved parts travel along `axis_A` into their mating pose
 /// (X_BM times their assembled poses) from `length_m` back along the axis.
 struct InsertionPath {
-  std::vector<int> moved;             ///< Parts of the moved input.
-  std::vector<int> base;              ///< Parts of the base input.
-  Iso3 X_BM = Iso3::Identity();       ///< Mating pose of the moved input relative to its
-                                      ///< assembled pose (a symmetric final pose; identity).
-  Vec3 axis_A = Vec3::UnitZ();        ///< Unit direction the moved input travels, frame A.
-  double length_m = 0.03;             ///< Path length back from the mating pose [m].
+  std::vector<int> moved;               ///< Parts of the moved input.
+  std::vector<int> base;                ///< Parts of the base input.
+  Iso3 X_BM = Iso3::Identity();         ///< Mating pose of the moved input relative to its
+                                        ///< assembled pose (a symmetric final pose; identity).
+  Vec3 axis_A = Vec3::UnitZ();          ///< Unit direction the moved input travels, frame A.
+  double length_m = 0.03;               ///< Path length back from the mating pose [m].
   double interference_travel_m = 1e-3;  ///< Final travel where interference is allowed [m].
   double interference_depth_m = 5e-4;   ///< Overlap allowed there [m].
   double touch_depth_m = 2e-4;          ///< Overlap read as touching elsewhere [m].
-  /// The sweep's step near the base [m]: a feature thinner than this could be jumped. Validation
-  /// takes 0.2 mm; a search over many directions may take coarser steps.
-  double min_step_m = 2e-4;
 };
 
 /// Where a path is blocked.
@@ -40,23 +37,23 @@ struct PathHit {
 
 /// Statistics of the sweeps (for benchmarks and tests).
 struct SweepStats {
-  int poses = 0;        ///< Poses of the moved input tested.
-  int pair_tests = 0;   ///< Part pairs whose distance FCL computed.
+  int part_pairs = 0;            ///< Pairs of a moved and a base part swept (per range of s).
+  long long box_tests = 0;       ///< Pairs of tree boxes whose travel interval was computed.
+  long long triangle_tests = 0;  ///< Pairs of triangles whose travel interval was computed.
 };
 
 /// The moved input's pose (frame A) `s_m` back along the path from its mating pose, for part p.
 Iso3 PathPose(const AssemblyGeometry& geometry, const InsertionPath& path, int part, double s_m);
 
-/// Sweeps the path inward, from `length_m` back to the mating pose, with the real meshes (FCL,
-/// surfaces moved inward by half the allowed overlap): far from the base by conservative
-/// advancement (each step the distance the meshes are apart), within 2 mm of it by FCL's
-/// collision test every path.min_step_m; nothing thicker than that step is jumped.
+/// Sweeps the path inward, from `length_m` back to the mating pose, with the real meshes
+/// (surfaces moved inward by half the allowed overlap): the exact continuous test of a
+/// translation (SweepContact), so nothing is stepped over, however thin, and `at_m` is exact.
 /// Returns the first overlap met coming in, or not blocked.
 PathHit SweepInsertion(AssemblyGeometry& geometry, const InsertionPath& path,
                        SweepStats* stats = nullptr);
 
-/// True when the path is free; sweeps outward from the mating pose and stops at the first
-/// overlap (cheaper than SweepInsertion for a blocked direction). `hit` gets it.
+/// True when the path is free; `hit` gets the overlap nearest the mating pose (the first met
+/// going out). The same exact sweep as SweepInsertion.
 bool IsPathFree(AssemblyGeometry& geometry, const InsertionPath& path, PathHit* hit = nullptr,
                 SweepStats* stats = nullptr);
 
@@ -81,8 +78,8 @@ struct PartOverlap {
 /// none. The pose test behind the checks that replay a plan (the plan validator's own sweep, the
 /// trajectory check, the simulation), each with its own poses.
 std::optional<PartOverlap> OverlapBeyond(AssemblyGeometry& geometry, const std::vector<int>& set_a,
-                                         const std::vector<int>& set_b,
-                                         const std::vector<Iso3>& X, double allowed_m);
+                                         const std::vector<int>& set_b, const std::vector<Iso3>& X,
+                                         double allowed_m);
 
 /// How natural an insertion axis is, higher is better: from above (the moved input comes down,
 /// gravity helps) before level before from below, axis-aligned before oblique. Orders the free

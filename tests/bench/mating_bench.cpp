@@ -1,11 +1,14 @@
 // Geometry-check timings on the example projects' real meshes (Fabrica ones when ../shared is
 // beside the repository):
 //
-//   BM_InsertionSweep/P/S  one step's insertion path swept into its mating pose (FCL on the inset
-//                          meshes, conservative advancement), the inset trees already built: what
+//   BM_InsertionSweep/P/S  one step's insertion path swept into its mating pose (the exact sweep of
+//                          a translation on the inset meshes), the sweep trees already built: what
 //                          validation and the planner pay per step (target < 50 ms)
 //   BM_ContactGraph/P      the whole contact graph of a project (distance and surface samples)
-//   BM_InsetTrees/P        building the inset meshes' FCL trees of every part (once per run)
+//   BM_InsetTrees/P        building the inset meshes' FCL trees of every part (once per run, for
+//                          the checks that replay a plan: OverlapBeyond)
+//   BM_SweepTrees/P        building the inset meshes and their sweep trees of every part, one
+//                          depth (once per run and depth, for the insertion sweeps)
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -22,8 +25,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kProjects = {"stool", "chair", "cube_2x2x3", "fabrica_beam",
-                                            "fabrica_plumbers_block", "fabrica_car"};
+const std::vector<std::string> kProjects = {
+    "stool", "chair", "cube_2x2x3", "fabrica_beam", "fabrica_plumbers_block", "fabrica_car"};
 
 struct Loaded {
   LoadedProject project;
@@ -54,7 +57,8 @@ void BM_InsertionSweep(benchmark::State& state) {
   SweepStats stats;
   (void)SweepInsertion(g, path, &stats);  // builds the inset trees
   for (auto _ : state) benchmark::DoNotOptimize(SweepInsertion(g, path));
-  state.SetLabel(p.name + " " + p.steps[s].name + " (" + std::to_string(stats.poses) + " poses)");
+  state.SetLabel(p.name + " " + p.steps[s].name + " (" + std::to_string(stats.triangle_tests) +
+                 " triangle pairs, " + std::to_string(stats.box_tests) + " box pairs)");
 }
 
 void BM_ContactGraph(benchmark::State& state) {
@@ -84,6 +88,22 @@ void BM_InsetTrees(benchmark::State& state) {
   state.SetLabel(l.project.project->name);
 }
 
+void BM_SweepTrees(benchmark::State& state) {
+  const Loaded& l = Load(kProjects[state.range(0)]);
+  if (!l.ok) {
+    state.SkipWithError("project not available");
+    return;
+  }
+  const Project& p = *l.project.project;
+  for (auto _ : state) {
+    AssemblyGeometry g = AssemblyGeometry::FromProject(p, l.project.check);
+    for (int part = 0; part < g.num_parts(); ++part) {
+      benchmark::DoNotOptimize(&g.sweep_mesh(part, 0.5 * p.geometry.touch_depth_m));
+    }
+  }
+  state.SetLabel(p.name);
+}
+
 // One benchmark per step of each project (the project files parsed without their meshes).
 void StepArgs(benchmark::internal::Benchmark* b) {
   for (int p = 0; p < static_cast<int>(kProjects.size()); ++p) {
@@ -100,6 +120,7 @@ void ProjectArgs(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_InsertionSweep)->Apply(StepArgs)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ContactGraph)->Apply(ProjectArgs)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_InsetTrees)->Apply(ProjectArgs)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_SweepTrees)->Apply(ProjectArgs)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace wrap
