@@ -72,7 +72,8 @@ KeyframeSolver::KeyframeSolver(const TaskWorld& world, TaskTables& tables,
       options_(options),
       cell_(std::move(cell)),
       counters_(counters),
-      checker_(WrenchOptions{.first_failure_suffices = true}) {
+      checker_(WrenchOptions{.first_failure_suffices = true,
+                              .on_question = options.wrench_question_observer}) {
   frames_.resize(world.robots.size());
   for (size_t r = 0; r < world.robots.size(); ++r) {
     frames_[r].resize(world.robots[r].chain.links.size());

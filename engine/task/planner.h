@@ -22,6 +22,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <set>
 #include <string>
@@ -69,6 +70,8 @@ struct TaskPlannerOptions {
   long long memory_limit_mb = 4096;
   MatingWrenchMode wrench_mode = MatingWrenchMode::kFull;  ///< full, gravity or none.
   double force_scale = 1.0;  ///< Lambda on the mating force and torque, >= 0.
+  /// Sees every wrench question the search computes (WrenchOptions::on_question; thread-safe).
+  std::function<void(const StepConfiguration&, const WrenchQuery&)> wrench_question_observer;
   /// Skill lengths and the robots' clearance at keyframes (shared with the motion stage).
   SkillGeometry skills;
   int max_effort = 2;  ///< Highest effort level (0-based) of the IK and pose sampling.

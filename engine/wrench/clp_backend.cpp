@@ -54,9 +54,10 @@ class ClpBackend final : public LpBackend {
       Load(problem, model);
       model.dual();
       solution.iterations = model.numberIterations();
-      if (model.status() == 1 || model.status() == 2) {
-        // Clp 1.17's scaled dual simplex sometimes calls an unbounded problem infeasible: confirm
-        // either verdict with the unscaled primal simplex (kept unless that one fails).
+      if (model.status() != 0) {
+        // Clp 1.17's scaled dual simplex sometimes calls an unbounded problem infeasible, or
+        // stops without an answer on a planner's LP that has one: confirm or replace its verdict
+        // with the unscaled primal simplex (kept unless that one fails too).
         ClpSimplex check;
         Load(problem, check);
         check.scaling(0);
@@ -69,6 +70,9 @@ class ClpBackend final : public LpBackend {
           return solution.status = LpStatus::kOptimal;
         }
         if (check.status() == 1 || check.status() == 2) model.setProblemStatus(check.status());
+      }
+      if (model.status() == 0 && BetterByPrimal(problem, model.objectiveValue(), solution)) {
+        return solution.status = LpStatus::kOptimal;
       }
       switch (model.status()) {
         case 0:
@@ -94,6 +98,29 @@ class ClpBackend final : public LpBackend {
   }
 
  private:
+  // Clp's dual optimum can be wrong: on questions recorded from the planner's searches
+  // (tests/wrench/data) it stopped at a load factor of 0 where the unscaled primal simplex (and
+  // our dense simplex) balance the load. Both claim optimality; the lower objective is attained
+  // by a feasible point, so it is the right one. True when the primal's is lower (then in
+  // `solution`); a primal that fails or throws leaves the dual's answer.
+  bool BetterByPrimal(const LpProblem& problem, double dual_objective, LpSolution& solution) {
+    try {
+      ClpSimplex check;
+      Load(problem, check);
+      check.scaling(0);
+      check.primal();
+      solution.iterations += check.numberIterations();
+      const double better = dual_objective - 1e-9 * (1.0 + std::abs(dual_objective));
+      if (check.status() != 0 || !(check.objectiveValue() < better)) return false;
+      const double* x = check.primalColumnSolution();
+      for (int j = 0; j < problem.cols; ++j) solution.x[j] = x[j];
+      solution.objective = check.objectiveValue();
+      return true;
+    } catch (...) {  // CoinError is not a std::exception.
+      return false;
+    }
+  }
+
   void Load(const LpProblem& problem, ClpSimplex& model) const {
     model.setLogLevel(0);
     model.loadProblem(problem.cols, problem.rows, starts_.data(), index_.data(), value_.data(),

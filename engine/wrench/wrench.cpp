@@ -319,6 +319,7 @@ Result<WrenchCheck> WrenchChecker::Impl::Finish(const StepConfiguration& explain
 Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config,
                                                  const WrenchQuery& query) {
   if (auto valid = detail::Validate(config, query); !valid) return std::unexpected(valid.error());
+  if (options.on_question) options.on_question(config, query);
   const WrenchGate gate = query.gate;
   const bool grippers_on = detail::GrippersActive(gate);
   const bool tables_on = detail::TablesActive(gate);

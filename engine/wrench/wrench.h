@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -175,6 +176,10 @@ struct WrenchOptions {
   /// the vertices checked. Each check then starts at the vertex that failed last (the planner's
   /// questions come in runs of similar configurations). For searches that need a yes or no.
   bool first_failure_suffices = false;
+  /// Called with every question the checker computes (not those its cache answers): how the
+  /// planner's real questions are recorded as test data (tests/wrench). Checkers of parallel
+  /// searches share it: it must be thread-safe.
+  std::function<void(const StepConfiguration&, const WrenchQuery&)> on_question;
   std::size_t cache_capacity = 1 << 16;  ///< Cached answers kept; the cache is emptied when full.
 };
 

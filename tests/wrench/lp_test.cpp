@@ -5,10 +5,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
-#include <string>
 #include <limits>
 #include <random>
+#include <sstream>
+#include <string>
 
 #include "wrench/lp.h"
 #include "wrench/wrench.h"
@@ -174,8 +174,8 @@ LpProblem ReadLp(const std::string& file) {
 // pivots on tiny entries): it must find Clp's optimum, from a cold start and through the varying
 // column, and at other scales.
 TEST(DenseSimplex, SolvesTheStoolMatingLpThatOnceFailed) {
-  const LpProblem p = ReadLp(std::string(WRAP_SOURCE_DIR) +
-                             "/tests/wrench/data/stool_seed2_mating_lp.txt");
+  const LpProblem p =
+      ReadLp(std::string(WRAP_SOURCE_DIR) + "/tests/wrench/data/stool_seed2_mating_lp.txt");
   ASSERT_EQ(p.rows, 30);
   ASSERT_EQ(p.cols, 43);
   std::unique_ptr<LpBackend> dense = MakeDenseSimplexBackend();
@@ -191,11 +191,14 @@ TEST(DenseSimplex, SolvesTheStoolMatingLpThatOnceFailed) {
     EXPECT_NEAR(a.objective, b.objective, 1e-6 * (1.0 + std::abs(b.objective))) << scale;
     EXPECT_LT(Violation(q, a.x), 1e-7) << "scale " << scale;
   }
-  EXPECT_NEAR([&] {
-    LpSolution b;
-    clp->Solve(p, b);
-    return b.objective;
-  }(), -3.9607, 1e-3) << "the load factor s = 3.96";
+  EXPECT_NEAR(
+      [&] {
+        LpSolution b;
+        clp->Solve(p, b);
+        return b.objective;
+      }(),
+      -3.9607, 1e-3)
+      << "the load factor s = 3.96";
 }
 
 // The wrench LP's shape: A x + s w = 0, bounds containing 0, maximise s (the last column), solved
