@@ -575,7 +575,10 @@ Result<StepAssembly> ReadStep(const fs::path& path, const StepTessellation& tess
   const std::string file = path.string();
   OcctSession session;
   Interface_Static::SetCVal("xstep.cascade.unit", "MM");
-  Interface_Static::SetIVal("read.stepcaf.subshapes.name", 1);
+  // Off: with it on, OpenCASCADE 7.6's ExpandSubShapes dereferences a null representation item
+  // of a damaged file (found by fuzz_step; tests/fuzz/regressions/step). Parts are named by their
+  // products and instances, which this does not touch.
+  Interface_Static::SetIVal("read.stepcaf.subshapes.name", 0);
   XCAFDoc_DocumentTool::SetLengthUnit(session.doc(), kMetresPerMm);
   STEPCAFControl_Reader reader;
   reader.SetColorMode(Standard_True);
