@@ -98,8 +98,10 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
   constexpr int kChunk = 6;
   if (!SetScene(seg.openings)) return;
   std::vector<std::vector<Aabb>> sweep;  // per body: [0] all, then chunks
+  std::vector<double> sweep_u;           // per chunk: the path parameter of its first sample
   std::vector<Aabb> sample;
   int count = 0;
+  double u = 0.0;  // the path parameter of the sample
   auto merge = [](Aabb& into, const Aabb& b) {
     into.min = into.min.cwiseMin(b.min);
     into.max = into.max.cwiseMax(b.max);
@@ -113,10 +115,12 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
     if (sweep.size() != sample.size()) {  // first sample (or a body appeared: start over)
       sweep.assign(sample.size(), {});
       for (size_t b = 0; b < sample.size(); ++b) sweep[b] = {sample[b], sample[b]};
+      sweep_u = {0.0};  // (from the start: the samples before a restart are not kept)
       count = 1;
       return;
     }
     const bool fresh = count % kChunk == 0;
+    if (fresh) sweep_u.push_back(u);
     for (size_t b = 0; b < sample.size(); ++b) {
       merge(sweep[b][0], sample[b]);
       if (fresh) {
@@ -136,6 +140,7 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
     const int steps = std::max(1, static_cast<int>(std::ceil(l1 / kSweepStep)));
     for (int s = 1; s <= steps; ++s) {
       const double t = static_cast<double>(s) / steps;
+      u = static_cast<double>(k - 1) + t;
       for (size_t i = 0; i < seg.robots.size(); ++i) {
         scene_.SetRobot(seg.robots[i], wp[k - 1][i] + t * (wp[k][i] - wp[k - 1][i]));
       }
@@ -149,6 +154,7 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
     }
   }
   seg.sweep = std::move(sweep);
+  seg.sweep_u = std::move(sweep_u);
 }
 
 std::vector<double> SegmentBuilder::SceneKey() const {
