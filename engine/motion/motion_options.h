@@ -22,10 +22,13 @@ struct RetimeOptions {
   /// is the same either way).
   bool concurrent = true;
   /// The collision test of overlapping motions samples states no farther apart than this in any
-  /// joint of any robot [rad]. No coarser than the trajectory check's 0.02 rad; finer, so that
-  /// the check, sampling other moments, meets no graze the schedule stepped over.
+  /// joint of any robot [rad]: no coarser than the trajectory check's 0.02 rad. The check
+  /// samples other moments; where it meets a graze between the schedule's samples, PlanMotion
+  /// schedules that segment after everything before it.
   double resolution_rad = 0.02;
-  /// Bodies of a segment keep this far from what other robots move or leave meanwhile [m].
+  /// Bodies of a segment keep this far from what other robots move or leave meanwhile [m]
+  /// (the motion planner's margin is 0; a positive one makes each test a distance query, about
+  /// ten times dearer).
   double clearance_m = 0.0;
 };
 
