@@ -81,7 +81,7 @@ class CarryLoad {
 // starts, so the slow-downs are found on segments one at a time, and the schedule is made once.
 Result<Timing> RetimeWithinLoads(const TaskWorld& world, Plan& plan,
                                  std::vector<GeoSegment>& segments, const RetimeOptions& options,
-                                 RunContext& ctx) {
+                                 MotionScene& scene, RunContext& ctx) {
   // An object carried by one robot loads its gripper at most this fraction of the limits, weight
   // and inertia together (MuJoCo's welds see the same), by slowing its segments down, at most
   // kMaxSlow times.
@@ -123,7 +123,7 @@ Result<Timing> RetimeWithinLoads(const TaskWorld& world, Plan& plan,
     timing = Retime(world, plan, segments, one_at_a_time, &ctx);
   }
   if (!timing) return timing;
-  return Retime(world, plan, segments, options, &ctx);
+  return Retime(world, plan, segments, options, &ctx, &scene);
 }
 
 // The plan takes the timing: trajectories, timed segments, the actions' times, the stats.
@@ -194,19 +194,27 @@ struct Timed {
   std::optional<TrajectoryCheck> check;
 };
 
-// Retimes `segments` into `plan` and, with options.self_check, checks the result. A collision
-// the check finds where segments ran beside others is a graze between the schedule's samples
-// (it samples other moments than the check): the segments under way there are scheduled after
-// everything before them and the plan retimed, a few times at most. Adds its times to `out`.
+// Retimes `segments` into `plan` (posing the schedule's timeline in `scene`, the geometric
+// motion's)
+// and, with options.self_check, checks the result. A collision the check finds where segments
+// ran beside others is a graze between the schedule's samples (it samples other moments than
+// the check): the segments under way there are scheduled after everything before them and the
+// plan retimed, a few times at most. Adds its times to `out`.
 Result<Timed> TimeAndCheck(const TaskWorld& world, Plan& plan, std::vector<GeoSegment>& segments,
-                           const MotionOptions& options, RunContext& ctx, MotionAttempt& out) {
+                           const MotionOptions& options, std::optional<MotionScene>& scene,
+                           RunContext& ctx, MotionAttempt& out) {
   constexpr int kMaxSeparations = 4;
   std::vector<std::string> seen;  // the colliding pairs separated for
   for (int separation = 0;; ++separation) {
     auto t0 = std::chrono::steady_clock::now();
+    if (!scene) {  // (the geometric motion made it)
+      auto built = MotionScene::Build(world);
+      if (!built) return std::unexpected(built.error());
+      scene = std::move(*built);
+    }
     ctx.Progress("retime", -1.0,
                  std::to_string(segments.size()) + " segments timed into per-robot trajectories");
-    auto timing = RetimeWithinLoads(world, plan, segments, options.retime, ctx);
+    auto timing = RetimeWithinLoads(world, plan, segments, options.retime, *scene, ctx);
     const double t_retime = Since(t0);
     out.t_retime_s += t_retime;
     ctx.AddTime("retime", t_retime);
@@ -280,26 +288,30 @@ void SetTimedFailure(const Plan& plan, const TrajectoryCheck& check, MotionFailu
 }  // namespace
 
 Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const MotionOptions& options,
-                                 const MotionRequest& request, MotionCache& cache,
-                                 RunContext& ctx) {
+                                 const MotionRequest& request, MotionCache& cache, RunContext& ctx,
+                                 std::optional<MotionScene>* kept) {
   // Times a free path is searched again with another seed when the timed result grazes
   // something inside it (a contact narrower than the path search's step: see below).
   constexpr int kMaxRepairs = 3;
   MotionAttempt out;
   const std::vector<PlanAction> original = plan.actions;
+  // The motion scene of the geometric motion and of the schedule: its cells are built once.
+  std::optional<MotionScene> own;
+  std::optional<MotionScene>& scene = kept ? *kept : own;
   for (int repair = 0;; ++repair) {
     out.failure = {};
     plan.actions = original;
     auto t0 = std::chrono::steady_clock::now();
     Plan work = plan;  // keyframes may be rebranched: only a plan with motion keeps them
-    auto segments = PlanGeometricMotion(world, work, options, request, cache, ctx, &out.failure);
+    auto segments =
+        PlanGeometricMotion(world, work, options, request, cache, ctx, &out.failure, &scene);
     const double t_geo = Since(t0);
     out.t_mp_s += t_geo;
     ctx.AddTime("mp", t_geo);
     if (!segments) return std::unexpected(segments.error());
     if (segments->empty()) return out;
     plan.actions = std::move(work.actions);
-    auto timed = TimeAndCheck(world, plan, *segments, options, ctx, out);
+    auto timed = TimeAndCheck(world, plan, *segments, options, scene, ctx, out);
     if (!timed) return std::unexpected(timed.error());
     if (!timed->check || timed->check->valid) break;
     const TrajectoryCheck* check = &*timed->check;

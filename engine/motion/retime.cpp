@@ -216,7 +216,7 @@ std::vector<RobotTrajectory> Trajectories(const Plan& plan, const std::vector<Ge
 
 Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
                       const std::vector<GeoSegment>& segments, const RetimeOptions& options,
-                      const RunContext* log) {
+                      const RunContext* log, MotionScene* scene) {
   const int n_robots = static_cast<int>(world.robots.size());
   const int n_seg = static_cast<int>(segments.size());
   for (const GeoSegment& s : segments) {
@@ -238,7 +238,7 @@ Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
   for (const GeoSegment& s : segments) timed.push_back(detail::TimeSegment(world, s));
   for (const detail::TimedSegment& ts : timed) out.makespan_sequential_s += ts.duration;
 
-  detail::Scheduler scheduler(world, plan, segments, timed, options, log);
+  detail::Scheduler scheduler(world, plan, segments, timed, options, log, scene);
   detail::ScheduleStats stats;
   auto slots = scheduler.Run(&stats);
   if (!slots) return std::unexpected(slots.error());

@@ -44,13 +44,15 @@ struct Timing {
 
 /// Times the geometric motion `segments` of `plan` (from PlanGeometricMotion, in its order) and
 /// schedules it with `options`; `log` (may be null) gets, under "motion", what each segment
-/// waits for. The segments' sweeps (GeoSegment::sweep) only spare the collision test where they
-/// never meet; a segment without one is tested wherever it overlaps another in time.
-/// Deterministic. Fails with kInvalidInput when a segment's robots or waypoints do not fit the
-/// world or the motion scene does not build.
+/// waits for; `scene` (may be null: Retime builds one) is a motion scene of `world` to pose the
+/// timeline in, kept by callers that retime the same world again (its cells are built once). The
+/// segments' sweeps (GeoSegment::sweep) only spare the collision test where they never meet; a
+/// segment without one is tested wherever it overlaps another in time. Deterministic. Fails with
+/// kInvalidInput when a segment's robots or waypoints do not fit the world or the motion scene does
+/// not build.
 [[nodiscard]] Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
                                     const std::vector<GeoSegment>& segments,
                                     const RetimeOptions& options = {},
-                                    const RunContext* log = nullptr);
+                                    const RunContext* log = nullptr, MotionScene* scene = nullptr);
 
 }  // namespace wrap

@@ -138,10 +138,17 @@ struct Window {
 // collide with nothing placed before it.
 class Scheduler {
  public:
+  // `scene` (may be null: the scheduler builds its own) poses the timeline's cell.
   Scheduler(const TaskWorld& world, const Plan& plan, const std::vector<GeoSegment>& segments,
             const std::vector<TimedSegment>& timed, const RetimeOptions& options,
-            const RunContext* log)
-      : w_(world), plan_(plan), segs_(segments), timed_(timed), opt_(options), log_(log) {}
+            const RunContext* log, MotionScene* scene)
+      : w_(world),
+        plan_(plan),
+        segs_(segments),
+        timed_(timed),
+        opt_(options),
+        log_(log),
+        scene_(scene) {}
 
   // Every segment's slot, in the input order. Fails with kInvalidInput when the motion scene
   // does not build.
@@ -196,7 +203,8 @@ class Scheduler {
   const std::vector<TimedSegment>& timed_;
   const RetimeOptions& opt_;
   const RunContext* log_;
-  std::optional<MotionScene> scene_;
+  MotionScene* scene_ = nullptr;
+  std::optional<MotionScene> own_scene_;
   ScheduleStats stats_;
   std::vector<Slot> slots_;
   std::vector<char> placed_;

@@ -87,10 +87,11 @@ Result<std::vector<Slot>> Scheduler::Run(ScheduleStats* stats) {
   placed_.assign(n, 0);
   robot_segments_.assign(n_robots, {});
   last_of_robot_.assign(n_robots, -1);
-  if (n > 1 && opt_.concurrent) {
+  if (n > 1 && opt_.concurrent && scene_ == nullptr) {
     auto scene = MotionScene::Build(w_);
     if (!scene) return std::unexpected(scene.error());
-    scene_ = std::move(*scene);
+    own_scene_ = std::move(*scene);
+    scene_ = &*own_scene_;
   }
   Prepare();
   for (int j = 0; j < n; ++j) Place(j);

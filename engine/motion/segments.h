@@ -78,13 +78,16 @@ double LoadRatio(const SoleLoad& load, const Mat3& R_WG, const Vec3& accel_W = V
 /// joints at that keyframe and the following ones where it stood still (validate the plan again).
 /// On success the segments in execution order (the plan's order; the schedule may overlap them);
 /// otherwise `failure` says which segment failed. `cache` keeps solved free paths between calls
-/// for the same plan. Deterministic for a given request.seed when no path search runs out of time.
+/// for the same plan. `scene` (may be null) keeps a motion scene of `world` between calls: built
+/// on the first (when empty), its cells are not built again (MotionScene::Set poses it afresh
+/// each time). Deterministic for a given request.seed when no path search runs out of time.
 /// Fails with kCancelled when ctx is cancelled and kInvalidInput when the plan does not fit the
 /// world.
 Result<std::vector<GeoSegment>> PlanGeometricMotion(const TaskWorld& world, Plan& plan,
                                                     const MotionOptions& options,
                                                     const MotionRequest& request,
                                                     MotionCache& cache, RunContext& ctx,
-                                                    MotionFailure* failure);
+                                                    MotionFailure* failure,
+                                                    std::optional<MotionScene>* scene = nullptr);
 
 }  // namespace wrap

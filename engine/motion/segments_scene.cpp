@@ -19,7 +19,7 @@ Result<void> SegmentBuilder::SetScene(const std::vector<double>& openings,
   // Objects still where they were picked from touch the table until they are lifted.
   std::vector<int> on_table = table_ok;
   on_table.insert(on_table.end(), grounded_.begin(), grounded_.end());
-  return scene_.Set(state_, openings, cur_, mating, on_table, gripper_ok);
+  return scene_->Set(state_, openings, cur_, mating, on_table, gripper_ok);
 }
 
 bool SegmentBuilder::Fail(int action, SegmentKind kind, bool suspend, const std::string& message,
@@ -43,7 +43,7 @@ FailureScene SegmentBuilder::CellNow() {
   FailureScene scene;
   scene.q = cur_;
   scene.X_WP.resize(w_.num_parts);
-  for (int p = 0; p < w_.num_parts; ++p) scene.X_WP[p] = scene_.cell().object_pose(p);
+  for (int p = 0; p < w_.num_parts; ++p) scene.X_WP[p] = scene_->cell().object_pose(p);
   return scene;
 }
 
@@ -108,9 +108,9 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
   };
   auto add = [&] {
     sample.clear();
-    for (int r : seg.robots) scene_.AppendBoxes(r, sample);
+    for (int r : seg.robots) scene_->AppendBoxes(r, sample);
     for (int node : seg.objects) {
-      if (state_.objects.count(node)) scene_.AppendObjectBoxes(node, sample);
+      if (state_.objects.count(node)) scene_->AppendObjectBoxes(node, sample);
     }
     if (sweep.size() != sample.size()) {  // first sample (or a body appeared: start over)
       sweep.assign(sample.size(), {});
@@ -132,7 +132,7 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
     ++count;
   };
   const auto& wp = seg.waypoints;
-  for (size_t i = 0; i < seg.robots.size(); ++i) scene_.SetRobot(seg.robots[i], wp[0][i]);
+  for (size_t i = 0; i < seg.robots.size(); ++i) scene_->SetRobot(seg.robots[i], wp[0][i]);
   add();
   for (size_t k = 1; k < wp.size(); ++k) {
     double l1 = 0.0;
@@ -142,7 +142,7 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
       const double t = static_cast<double>(s) / steps;
       u = static_cast<double>(k - 1) + t;
       for (size_t i = 0; i < seg.robots.size(); ++i) {
-        scene_.SetRobot(seg.robots[i], wp[k - 1][i] + t * (wp[k][i] - wp[k - 1][i]));
+        scene_->SetRobot(seg.robots[i], wp[k - 1][i] + t * (wp[k][i] - wp[k - 1][i]));
       }
       add();
     }
