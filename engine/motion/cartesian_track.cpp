@@ -132,12 +132,13 @@ bool SegmentBuilder::PathClear(const std::vector<int>& robots,
     for (int s = (k == 0 ? steps : 1); s <= steps; ++s) {
       const double t = static_cast<double>(s) / steps;
       for (size_t i = 0; i < robots.size(); ++i) {
-        scene_.SetRobot(robots[i], waypoints[prev][i] + t * (waypoints[k][i] - waypoints[prev][i]));
+        scene_->SetRobot(robots[i],
+                         waypoints[prev][i] + t * (waypoints[k][i] - waypoints[prev][i]));
       }
-      if (scene_.Collides(robots)) {
+      if (scene_->Collides(robots)) {
         CollisionResult hit;
-        scene_.cell().InCollision(&hit);
-        const CollisionWorld& cw = scene_.cell().world();
+        scene_->cell().InCollision(&hit);
+        const CollisionWorld& cw = scene_->cell().world();
         last_hit_ = "'" + cw.body_name(hit.first.body_a) + "' hits '" +
                     cw.body_name(hit.first.body_b) + "'";
         // The failure record's picture: the robots where they hit, the parts as set.
@@ -162,10 +163,10 @@ bool SegmentBuilder::Tight(int robot, const JointVector& q) {
   for (int t = 0; t < kTightSamples; ++t) {
     JointVector x = q;
     for (int j = 0; j < x.size(); ++j) x[j] += u(g);
-    scene_.SetRobot(robot, x);
-    bad += scene_.Collides(std::span<const int>(&robot, 1));
+    scene_->SetRobot(robot, x);
+    bad += scene_->Collides(std::span<const int>(&robot, 1));
   }
-  scene_.SetRobot(robot, q);
+  scene_->SetRobot(robot, q);
   return bad > kTightSamples / 8;
 }
 

@@ -28,10 +28,10 @@ bool SegmentBuilder::MoveOpening(int robot, double wanted) {
   opening_[robot] = wanted;
   if (wanted == now) return true;
   if (!SetScene(opening_)) return false;
-  if (!scene_.Collides(std::vector<int>{robot})) return true;
+  if (!scene_->Collides(std::vector<int>{robot})) return true;
   opening_[robot] = now;
   if (!SetScene(opening_)) return false;
-  if (scene_.Collides(std::vector<int>{robot})) opening_[robot] = wanted;
+  if (scene_->Collides(std::vector<int>{robot})) opening_[robot] = wanted;
   return true;
 }
 
@@ -204,8 +204,8 @@ PathAnswer SegmentBuilder::FreeQuery(const FreeRequest& req, const std::vector<i
     for (size_t l = 0; l < loads.size(); ++l) {
       if (LoadRatio(loads[l], qs[load_bound[l].first]) > load_bound[l].second) return false;
     }
-    for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], qs[i]);
-    return !scene_.Collides(who);
+    for (size_t i = 0; i < who.size(); ++i) scene_->SetRobot(who[i], qs[i]);
+    return !scene_->Collides(who);
   };
   query.resolution = opt_.resolution_rad;
   query.max_checks = opt_.segment_checks << effort_;
@@ -220,7 +220,7 @@ PathAnswer SegmentBuilder::FreeQuery(const FreeRequest& req, const std::vector<i
   query.final_resolution = query.resolution / kRefine;
   const PathAnswer answer = PlanPath(query);
   const std::string hit = DescribeFreeFailure(action, who, to, answer);
-  for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], cur_[who[i]]);
+  for (size_t i = 0; i < who.size(); ++i) scene_->SetRobot(who[i], cur_[who[i]]);
   if (ctx_.Logs("motion")) {
     ctx_.Log(
         "motion",
@@ -242,9 +242,9 @@ std::string SegmentBuilder::DescribeFreeFailure(int action, const std::vector<in
   std::string hit;
   if (!ctx_.Logs("motion") || answer.solved || answer.timed_out) return hit;
   const bool at_start = answer.why.find("start") != std::string::npos;
-  for (size_t i = 0; i < who.size(); ++i) scene_.SetRobot(who[i], at_start ? cur_[who[i]] : to[i]);
+  for (size_t i = 0; i < who.size(); ++i) scene_->SetRobot(who[i], at_start ? cur_[who[i]] : to[i]);
   CollisionResult res;
-  if (scene_.cell().InCollision(&res)) hit = " (" + scene_.cell().Describe(res.first) + ")";
+  if (scene_->cell().InCollision(&res)) hit = " (" + scene_->cell().Describe(res.first) + ")";
   if (at_start) {
     for (int r : who) {
       std::string line =
@@ -268,10 +268,10 @@ void SegmentBuilder::DiagnoseFree(const FreeRequest& req) {
   std::vector<std::vector<JointVector>> p1, p2;
   const PathAnswer a1 = FreeQuery(req, movers, {w_.robots[movers[0]].home}, &p1);
   cur_[movers[0]] = targets[0];
-  scene_.SetRobot(movers[0], targets[0]);
+  scene_->SetRobot(movers[0], targets[0]);
   const PathAnswer a2 = FreeQuery(req, movers, {w_.robots[movers[0]].home}, &p2);
   cur_[movers[0]] = saved;
-  scene_.SetRobot(movers[0], saved);
+  scene_->SetRobot(movers[0], saved);
   // What the goal's neighbourhood hits.
   std::map<std::string, int> hits;
   {
@@ -280,14 +280,14 @@ void SegmentBuilder::DiagnoseFree(const FreeRequest& req) {
     for (int t = 0; t < 64; ++t) {
       JointVector x = targets[0];
       for (int j = 0; j < x.size(); ++j) x[j] += u(g);
-      scene_.SetRobot(movers[0], x);
+      scene_->SetRobot(movers[0], x);
       CollisionResult res;
-      if (scene_.cell().InCollision(&res)) {
-        const CollisionWorld& cw = scene_.cell().world();
+      if (scene_->cell().InCollision(&res)) {
+        const CollisionWorld& cw = scene_->cell().world();
         ++hits[cw.body_name(res.first.body_a) + " ~ " + cw.body_name(res.first.body_b)];
       }
     }
-    scene_.SetRobot(movers[0], saved);
+    scene_->SetRobot(movers[0], saved);
   }
   std::string near;
   for (const auto& [k, v] : hits) near += " " + k + " x" + std::to_string(v);

@@ -7,6 +7,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
 
 #include "motion/retime.h"
 #include "motion/scene.h"
@@ -74,15 +77,19 @@ class CarryLoad {
 
 // Retime, and where an object carried by one robot would load its gripper beyond kMaxLoad with
 // its weight and inertia, that segment runs slower (the inertial part falls with the square of
-// the time stretch) and the schedule is made again (g.slow of `segments` set).
+// the time stretch; g.slow of `segments` set). A segment's own timing does not depend on when it
+// starts, so the slow-downs are found on segments one at a time, and the schedule is made once.
 Result<Timing> RetimeWithinLoads(const TaskWorld& world, Plan& plan,
-                                 std::vector<GeoSegment>& segments, RunContext& ctx) {
+                                 std::vector<GeoSegment>& segments, const RetimeOptions& options,
+                                 MotionScene& scene, RunContext& ctx) {
   // An object carried by one robot loads its gripper at most this fraction of the limits, weight
   // and inertia together (MuJoCo's welds see the same), by slowing its segments down, at most
   // kMaxSlow times.
   constexpr double kMaxLoad = 0.9;
   constexpr double kMaxSlow = 6.0;
-  auto timing = Retime(world, plan, segments, &ctx);
+  RetimeOptions one_at_a_time = options;
+  one_at_a_time.concurrent = false;
+  auto timing = Retime(world, plan, segments, one_at_a_time, &ctx);
   const std::vector<PlanState> states = ReplayPlanStates(plan);
   for (int round = 0; round < 4 && timing; ++round) {
     bool slowed = false;
@@ -113,9 +120,10 @@ Result<Timing> RetimeWithinLoads(const TaskWorld& world, Plan& plan,
       slowed = true;
     }
     if (!slowed) break;
-    timing = Retime(world, plan, segments, &ctx);
+    timing = Retime(world, plan, segments, one_at_a_time, &ctx);
   }
-  return timing;
+  if (!timing) return timing;
+  return Retime(world, plan, segments, options, &ctx, &scene);
 }
 
 // The plan takes the timing: trajectories, timed segments, the actions' times, the stats.
@@ -152,6 +160,112 @@ std::vector<int> FreePathsAt(const std::vector<GeoSegment>& segments, const Timi
   return redo;
 }
 
+// The segments to schedule after everything before them when the trajectory check finds a
+// collision at t: the segment under way then (or the last before) of the robot it names, where
+// that was scheduled beside others; otherwise every robot's such segment.
+std::vector<int> ConcurrentAt(const std::vector<GeoSegment>& segments, const Timing& timing,
+                              const TrajectoryIssue& issue) {
+  std::map<int, int> last;  // robot -> segment
+  for (size_t j = 0; j < segments.size(); ++j) {
+    if (timing.segment_start_s[j] > issue.t + 1e-9) continue;
+    for (int r : segments[j].robots) {
+      auto [it, fresh] = last.try_emplace(r, static_cast<int>(j));
+      if (!fresh && timing.segment_start_s[j] >= timing.segment_start_s[it->second]) {
+        it->second = static_cast<int>(j);
+      }
+    }
+  }
+  auto movable = [&](int j) { return timing.segment_concurrent[j] && !segments[j].after_all; };
+  if (auto it = last.find(issue.robot); it != last.end() && movable(it->second)) {
+    return {it->second};
+  }
+  std::vector<int> out;
+  for (const auto& [r, j] : last) {
+    if (movable(j)) out.push_back(j);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// A timing and the trajectory check's verdict on it (none without the self-check).
+struct Timed {
+  Timing timing;
+  std::optional<TrajectoryCheck> check;
+};
+
+// Retimes `segments` into `plan` (posing the schedule's timeline in `scene`, the geometric
+// motion's)
+// and, with options.self_check, checks the result. A collision the check finds where segments
+// ran beside others is a graze between the schedule's samples (it samples other moments than
+// the check): the segments under way there are scheduled after everything before them and the
+// plan retimed, a few times at most. Adds its times to `out`.
+Result<Timed> TimeAndCheck(const TaskWorld& world, Plan& plan, std::vector<GeoSegment>& segments,
+                           const MotionOptions& options, std::optional<MotionScene>& scene,
+                           RunContext& ctx, MotionAttempt& out) {
+  constexpr int kMaxSeparations = 4;
+  std::vector<std::string> seen;  // the colliding pairs separated for
+  for (int separation = 0;; ++separation) {
+    auto t0 = std::chrono::steady_clock::now();
+    if (!scene) {  // (the geometric motion made it)
+      auto built = MotionScene::Build(world);
+      if (!built) return std::unexpected(built.error());
+      scene = std::move(*built);
+    }
+    ctx.Progress("retime", -1.0,
+                 std::to_string(segments.size()) + " segments timed into per-robot trajectories");
+    auto timing = RetimeWithinLoads(world, plan, segments, options.retime, *scene, ctx);
+    const double t_retime = Since(t0);
+    out.t_retime_s += t_retime;
+    ctx.AddTime("retime", t_retime);
+    if (!timing) return std::unexpected(timing.error());
+    if (ctx.Logs("motion")) {
+      ctx.Log("motion",
+              StrFormat("schedule: makespan %.2f s (one at a time %.2f s), %d of %zu segments wait "
+                        "for a collision; %d start times tried, %d tested, %lld moments, %.3f s",
+                        timing->makespan_s, timing->makespan_sequential_s, timing->collision_waits,
+                        segments.size(), timing->candidates, timing->checked_candidates,
+                        timing->check_samples, t_retime));
+    }
+    Timed result;
+    KeepTiming(plan, *timing, segments.size());
+    result.timing = std::move(*timing);
+    if (!options.self_check) return result;
+    t0 = std::chrono::steady_clock::now();
+    ctx.Progress("check", -1.0, "the timed trajectories, densely");
+    TrajectoryCheckOptions check_options;
+    check_options.log = &ctx;
+    auto check = CheckTrajectories(world, plan, check_options);
+    out.t_mp_s += Since(t0);
+    if (!check) return std::unexpected(check.error());
+    result.check = std::move(*check);
+    if (!result.check->valid && !options.dump_refused_dir.empty()) {
+      // Debugging: keep every refused timed result (a folder; one file per refusal).
+      static std::atomic<int> dumped = 0;
+      (void)SavePlan(plan,
+                     options.dump_refused_dir / ("refused_" + std::to_string(dumped++) + ".json"));
+    }
+    if (result.check->valid || separation >= kMaxSeparations) return result;
+    const TrajectoryIssue& issue = result.check->issues.front();
+    if (issue.check != "collision") return result;
+    // The same two bodies again, after their segments were set apart: not the schedule's doing
+    // (a graze inside one path, which the check's other moments now meet); the caller searches
+    // the path again.
+    const std::string pair = issue.message.substr(0, issue.message.find(" ("));
+    if (std::find(seen.begin(), seen.end(), pair) != seen.end()) return result;
+    seen.push_back(pair);
+    const std::vector<int> apart = ConcurrentAt(segments, result.timing, issue);
+    if (apart.empty()) return result;
+    if (ctx.Logs("motion")) {
+      std::string list;
+      for (int j : apart) list += " " + std::to_string(j);
+      ctx.Log("motion", "timed: " + FormatTrajectoryIssue(plan, issue) + " (segments" + list +
+                            " are scheduled after everything before them)");
+    }
+    for (int j : apart) segments[j].after_all = true;
+  }
+}
+
 // The failure of a timed result the trajectory check refused: the action under way at the first
 // issue's moment, not to be retried. (failure.scene is left as it is.)
 void SetTimedFailure(const Plan& plan, const TrajectoryCheck& check, MotionFailure& failure) {
@@ -174,43 +288,34 @@ void SetTimedFailure(const Plan& plan, const TrajectoryCheck& check, MotionFailu
 }  // namespace
 
 Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const MotionOptions& options,
-                                 const MotionRequest& request, MotionCache& cache,
-                                 RunContext& ctx) {
+                                 const MotionRequest& request, MotionCache& cache, RunContext& ctx,
+                                 std::optional<MotionScene>* kept) {
   // Times a free path is searched again with another seed when the timed result grazes
   // something inside it (a contact narrower than the path search's step: see below).
   constexpr int kMaxRepairs = 3;
   MotionAttempt out;
   const std::vector<PlanAction> original = plan.actions;
+  // The motion scene of the geometric motion and of the schedule: its cells are built once.
+  std::optional<MotionScene> own;
+  std::optional<MotionScene>& scene = kept ? *kept : own;
   for (int repair = 0;; ++repair) {
     out.failure = {};
     plan.actions = original;
     auto t0 = std::chrono::steady_clock::now();
     Plan work = plan;  // keyframes may be rebranched: only a plan with motion keeps them
-    auto segments = PlanGeometricMotion(world, work, options, request, cache, ctx, &out.failure);
+    auto segments =
+        PlanGeometricMotion(world, work, options, request, cache, ctx, &out.failure, &scene);
     const double t_geo = Since(t0);
     out.t_mp_s += t_geo;
     ctx.AddTime("mp", t_geo);
     if (!segments) return std::unexpected(segments.error());
     if (segments->empty()) return out;
-    t0 = std::chrono::steady_clock::now();
     plan.actions = std::move(work.actions);
-    ctx.Progress("retime", -1.0,
-                 std::to_string(segments->size()) + " segments timed into per-robot trajectories");
-    auto timing = RetimeWithinLoads(world, plan, *segments, ctx);
-    const double t_retime = Since(t0);
-    out.t_retime_s += t_retime;
-    ctx.AddTime("retime", t_retime);
-    if (!timing) return std::unexpected(timing.error());
-    KeepTiming(plan, *timing, segments->size());
-    if (!options.self_check) break;
-    t0 = std::chrono::steady_clock::now();
-    ctx.Progress("check", -1.0, "the timed trajectories, densely");
-    TrajectoryCheckOptions check_options;
-    check_options.log = &ctx;
-    auto check = CheckTrajectories(world, plan, check_options);
-    out.t_mp_s += Since(t0);
-    if (!check) return std::unexpected(check.error());
-    if (check->valid) break;
+    auto timed = TimeAndCheck(world, plan, *segments, options, scene, ctx, out);
+    if (!timed) return std::unexpected(timed.error());
+    if (!timed->check || timed->check->valid) break;
+    const TrajectoryCheck* check = &*timed->check;
+    const Timing* timing = &timed->timing;
     const TrajectoryIssue& issue = check->issues.front();
     // A collision inside a free path: the path search checks states 0.0025 rad apart and the
     // check samples other moments, so a graze narrower than the search's step (a finger or a
@@ -223,12 +328,6 @@ Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan, const Motio
     if (ctx.Logs("motion")) {
       ctx.Log("motion", "timed: " + FormatTrajectoryIssue(plan, issue) +
                             (redo.empty() ? "" : " (its free paths are searched again)"));
-    }
-    if (!options.dump_refused_dir.empty()) {
-      // Debugging: keep every refused timed result (a folder; one file per refusal).
-      static std::atomic<int> dumped = 0;
-      (void)SavePlan(plan,
-                     options.dump_refused_dir / ("refused_" + std::to_string(dumped++) + ".json"));
     }
     plan.trajectories.clear();
     plan.segments.clear();

@@ -4,9 +4,12 @@
 // failure record and path cache are in motion_options.h, included here).
 #pragma once
 
+#include <optional>
+
 #include "core/result.h"
 #include "core/run_context.h"
 #include "motion/motion_options.h"
+#include "motion/scene.h"
 #include "task/plan.h"
 #include "task/world.h"
 
@@ -29,10 +32,14 @@ struct MotionAttempt {
 /// With options.self_check, timed trajectories that fail the independent check are not kept:
 /// the attempt fails (segment "timed", not to be retried) naming the first issue.
 ///
+/// `scene` (may be null) keeps the motion scene of `world` between attempts: built by the first
+/// (when empty), its collision cells are not built again.
+///
 /// Fails with kCancelled when ctx is cancelled, kInvalidInput when the plan does not fit the world.
 [[nodiscard]] Result<MotionAttempt> PlanMotion(const TaskWorld& world, Plan& plan,
                                                const MotionOptions& options,
                                                const MotionRequest& request, MotionCache& cache,
-                                               RunContext& ctx);
+                                               RunContext& ctx,
+                                               std::optional<MotionScene>* scene = nullptr);
 
 }  // namespace wrap

@@ -15,6 +15,23 @@
 
 namespace wrap {
 
+/// Options of the schedule that lets robots move at the same time (Retime, paper §IV-F).
+struct RetimeOptions {
+  /// Segments start as early as their robots, objects and timed conflicts allow. False: one at
+  /// a time in plan order, each once everything before it has ended (the segments' own timing
+  /// is the same either way).
+  bool concurrent = true;
+  /// The collision test of overlapping motions samples states no farther apart than this in any
+  /// joint of any robot [rad]: no coarser than the trajectory check's 0.02 rad. The check
+  /// samples other moments; where it meets a graze between the schedule's samples, PlanMotion
+  /// schedules that segment after everything before it.
+  double resolution_rad = 0.02;
+  /// Bodies of a segment keep this far from what other robots move or leave meanwhile [m]
+  /// (the motion planner's margin is 0; a positive one makes each test a distance query, about
+  /// ten times dearer).
+  double clearance_m = 0.0;
+};
+
 /// Options of the motion stage: the geometric motion, its timing and the self-check.
 struct MotionOptions {
   /// Joint-space resolution of the path search's collision checks along a motion: consecutive
@@ -45,6 +62,7 @@ struct MotionOptions {
   /// wrench gates hold at the keyframes only, and an object turned on the way (a seat held by
   /// its edge) can hang on its gripper beyond the limits; the rest is kept for the accelerations.
   double transport_load_max = 0.8;
+  RetimeOptions retime;  ///< The concurrent schedule.
   /// Run the independent trajectory check on the timed result; a plan that fails it has no
   /// motion (its first issue is the failure), so no colliding trajectory leaves the planner.
   bool self_check = true;

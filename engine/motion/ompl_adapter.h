@@ -32,7 +32,7 @@ struct PathQuery {
   /// of the paths it returns). Counted in work, not time, so that the same seed finds the same
   /// path whatever the machine's load; the run's deadline comes through `stop`.
   long long max_checks = 20000;
-  std::uint64_t seed = 0;     ///< Seeds sampling and shortcutting (deterministic per seed).
+  std::uint64_t seed = 0;  ///< Seeds sampling and shortcutting (deterministic per seed).
   /// Checked while planning: true stops at once (cancellation, the run's wall-clock deadline).
   std::function<bool()> stop;
   /// Random shortcut attempts after the path is found and shortcut greedily (each waypoint
@@ -49,7 +49,7 @@ struct PathQuery {
 /// What PlanPath found.
 struct PathAnswer {
   bool solved = false;                ///< A path was found.
-  bool timed_out = false;  ///< Not solved within the work budget (more effort may help).
+  bool timed_out = false;             ///< Not solved within the work budget (more effort may help).
   std::vector<Eigen::VectorXd> path;  ///< Waypoints from start to goal (solved only).
   /// The goal reached: 0 for `goal`, k for `other_goals[k - 1]` (solved only).
   int goal_index = 0;

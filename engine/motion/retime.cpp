@@ -1,24 +1,19 @@
+// Retiming (retime.h): each segment timed along its path (a trapezoid per straight piece), the
+// schedule (schedule.cpp) placing the timed segments, and the per-robot trajectories and timed
+// segments of the plan.
 #include "motion/retime.h"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
-#include <map>
 #include <string>
 
+#include "motion/retime_internal.h"
+
 namespace wrap {
+namespace detail {
 
 namespace {
-
-// A time-optimal rest-to-rest trapezoid in the path parameter s in [0, 1] of one straight piece.
-struct Profile {
-  double t_acc = 0.0;    // acceleration phase [s]
-  double t_total = 0.0;  // whole piece [s]
-  double s_acc = 0.0;    // s reached at the end of the acceleration phase
-  double v_peak = 0.0;   // peak ds/dt [1/s]
-};
 
 Profile Trapezoid(double vs, double as) {
   Profile p;
@@ -38,35 +33,48 @@ Profile Trapezoid(double vs, double as) {
   return p;
 }
 
-bool Overlap(const Aabb& a, const Aabb& b) {
-  return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
+}  // namespace
+
+double TimedSegment::TimeAt(double u) const {
+  if (pieces.empty() || !(u > 0.0)) return 0.0;
+  const size_t k = std::min(static_cast<size_t>(u), pieces.size() - 1);
+  const double s = std::clamp(u - static_cast<double>(k), 0.0, 1.0);
+  const Profile& p = pieces[k];
+  const double t0 = piece_t0[k];
+  if (!(p.t_total > 0.0) || !(p.s_acc > 0.0)) return t0;
+  // The trapezoid inverted: accelerating, cruising, braking.
+  if (s <= p.s_acc) return t0 + p.t_acc * std::sqrt(s / p.s_acc);
+  if (s <= 1.0 - p.s_acc) return t0 + p.t_acc + (s - p.s_acc) / p.v_peak;
+  return t0 + p.t_total - p.t_acc * std::sqrt(std::max(0.0, 1.0 - s) / p.s_acc);
 }
 
-// Sweeps (per body: the whole, then runs) meet: some pair of bodies whose wholes overlap has a
-// pair of runs that overlap.
-bool SweepsMeet(const std::vector<std::vector<Aabb>>& a, const std::vector<std::vector<Aabb>>& b) {
-  for (const auto& x : a) {
-    for (const auto& y : b) {
-      if (x.empty() || y.empty() || !Overlap(x[0], y[0])) continue;
-      for (size_t i = 1; i < x.size(); ++i) {
-        if (!Overlap(x[i], y[0])) continue;
-        for (size_t j = 1; j < y.size(); ++j) {
-          if (Overlap(x[i], y[j])) return true;
-        }
+JointVector TimedSegment::At(size_t i, double tau) const {
+  if (!(tau > t.front())) return q.front()[i];
+  if (tau >= t.back()) return q.back()[i];
+  const size_t k = static_cast<size_t>(std::upper_bound(t.begin(), t.end(), tau) - t.begin());
+  const double dt = t[k] - t[k - 1];
+  if (!(dt > 0.0)) return q[k][i];
+  const double h = tau - t[k - 1];
+  const JointVector acc = (qd[k][i] - qd[k - 1][i]) / dt;
+  return q[k - 1][i] + h * qd[k - 1][i] + 0.5 * h * h * acc;
+}
+
+std::vector<double> TimedSegment::Samples(double resolution_rad) const {
+  std::vector<double> out;
+  for (size_t k = 0; k < t.size(); ++k) {
+    if (k > 0) {
+      const double dt = t[k] - t[k - 1];
+      double v = 0.0;
+      for (size_t i = 0; i < qd[k].size(); ++i) {
+        v = std::max({v, qd[k][i].cwiseAbs().maxCoeff(), qd[k - 1][i].cwiseAbs().maxCoeff()});
       }
+      const int n = static_cast<int>(std::ceil(v * dt / resolution_rad));
+      for (int s = 1; s < n; ++s) out.push_back(t[k - 1] + dt * s / n);
     }
+    out.push_back(t[k]);
   }
-  return false;
+  return out;
 }
-
-// A segment's motion as knots relative to its start: per knot the time, and per robot q, qd.
-struct TimedSegment {
-  double duration = 0.0;
-  double stretch = 1.0;  // how much slower than its fastest timing
-  std::vector<double> t;
-  std::vector<std::vector<JointVector>> q;   // q[k][i]
-  std::vector<std::vector<JointVector>> qd;  // qd[k][i]
-};
 
 TimedSegment TimeSegment(const TaskWorld& world, const GeoSegment& seg) {
   TimedSegment out;
@@ -114,10 +122,12 @@ TimedSegment TimeSegment(const TaskWorld& world, const GeoSegment& seg) {
   double t0 = 0.0;
   for (size_t k = 1; k < seg.waypoints.size(); ++k) {
     Profile p = pieces[k - 1];
-    if (p.t_total <= 0.0) continue;
     p.t_acc *= f;
     p.t_total *= f;
     p.v_peak /= f;
+    out.pieces.push_back(p);
+    out.piece_t0.push_back(t0);
+    if (p.t_total <= 0.0) continue;
     const auto& a = seg.waypoints[k - 1];
     const auto& b = seg.waypoints[k];
     auto push = [&](double t, double s, double sd) {
@@ -139,74 +149,21 @@ TimedSegment TimeSegment(const TaskWorld& world, const GeoSegment& seg) {
   return out;
 }
 
-}  // namespace
+}  // namespace detail
 
-Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
-                      const std::vector<GeoSegment>& segments, const RunContext* log) {
-  const int n_robots = static_cast<int>(world.robots.size());
-  const int n_seg = static_cast<int>(segments.size());
-  for (const GeoSegment& s : segments) {
-    if (s.waypoints.empty()) return Fail(ErrorCode::kInvalidInput, "a motion segment is empty");
-    for (int r : s.robots) {
-      if (r < 0 || r >= n_robots) {
-        return Fail(ErrorCode::kInvalidInput, "a motion segment names robot " + std::to_string(r));
-      }
-    }
-  }
-  Timing out;
-  std::vector<TimedSegment> timed;
-  for (const GeoSegment& s : segments) timed.push_back(TimeSegment(world, s));
+namespace {
 
-  // The schedule.
-  std::vector<double> start(n_seg, 0.0), end(n_seg, 0.0);
-  std::vector<int> last_of_robot(n_robots, -1);
-  std::map<int, int> last_of_object;
-  for (int j = 0; j < n_seg; ++j) {
-    const GeoSegment& s = segments[j];
-    std::vector<char> dep(j, 0);  // 1 robot, 2 object, 3 sweep
-    for (int r : s.robots) {
-      if (last_of_robot[r] >= 0) dep[last_of_robot[r]] = 1;
-    }
-    for (int o : s.objects) {
-      if (auto it = last_of_object.find(o); it != last_of_object.end() && !dep[it->second]) {
-        dep[it->second] = 2;
-      }
-    }
-    for (int i = 0; i < j; ++i) {
-      if (!dep[i] && SweepsMeet(segments[i].sweep, s.sweep)) dep[i] = 3;
-    }
-    double t = 0.0;
-    int binding = -1;
-    for (int i = 0; i < j; ++i) {
-      if (dep[i]) {
-        if (end[i] > t) binding = i;
-        t = std::max(t, end[i]);
-        ++out.dependencies;
-      }
-    }
-    if (log && log->Logs("motion")) {
-      log->Log("motion", StrFormat("schedule: %d %s a%d waits for %d (%s)", j,
-                                   std::string(ToString(s.kind)).c_str(), s.action + 1, binding,
-                                   binding < 0                ? "-"
-                                   : dep[binding] == 1 ? "robot"
-                                   : dep[binding] == 2 ? "object"
-                                                       : "sweep"));
-    }
-    start[j] = t;
-    end[j] = t + timed[j].duration;
-    out.makespan_sequential_s += timed[j].duration;
-    for (int r : s.robots) last_of_robot[r] = j;
-    for (int o : s.objects) last_of_object[o] = j;
-  }
-  for (int j = 0; j < n_seg; ++j) out.makespan_s = std::max(out.makespan_s, end[j]);
+constexpr const char* kWaitNames[] = {"none", "robot", "object", "collision"};
 
-  // Trajectories.
-  std::vector<int> order(n_seg);
-  for (int j = 0; j < n_seg; ++j) order[j] = j;
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return start[a] < start[b]; });
-  out.trajectories.resize(n_robots);
+// Per robot, from the segments' slots: knots at every segment's start and end (resting between).
+std::vector<RobotTrajectory> Trajectories(const Plan& plan, const std::vector<GeoSegment>& segments,
+                                          const std::vector<detail::TimedSegment>& timed,
+                                          const std::vector<detail::Slot>& slots,
+                                          const std::vector<int>& order, double makespan) {
+  const int n_robots = static_cast<int>(plan.initial.q.size());
+  std::vector<RobotTrajectory> out(n_robots);
   for (int r = 0; r < n_robots; ++r) {
-    RobotTrajectory& tr = out.trajectories[r];
+    RobotTrajectory& tr = out[r];
     tr.robot = r;
     TrajectoryKnot k0;
     k0.t = 0.0;
@@ -216,21 +173,22 @@ Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
   }
   for (int j : order) {
     const GeoSegment& s = segments[j];
-    const TimedSegment& ts = timed[j];
+    const detail::TimedSegment& ts = timed[j];
+    const double start = slots[j].start_s;
     for (size_t i = 0; i < s.robots.size(); ++i) {
       const int r = s.robots[i];
-      RobotTrajectory& tr = out.trajectories[r];
+      RobotTrajectory& tr = out[r];
       const double opening = r < static_cast<int>(s.openings.size()) ? s.openings[r] : -1.0;
-      if (start[j] > tr.knots.back().t + 1e-12) {
+      if (start > tr.knots.back().t + 1e-12) {
         TrajectoryKnot wait = tr.knots.back();
-        wait.t = start[j];
+        wait.t = start;
         wait.qd.setZero();
         tr.knots.push_back(wait);
       }
       tr.knots.back().opening_m = opening;
       for (size_t k = 1; k < ts.t.size(); ++k) {
         TrajectoryKnot knot;
-        knot.t = start[j] + ts.t[k];
+        knot.t = start + ts.t[k];
         knot.q = ts.q[k][i];
         knot.qd = ts.qd[k][i];
         knot.opening_m = opening;
@@ -243,14 +201,63 @@ Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
       }
     }
   }
-  for (RobotTrajectory& tr : out.trajectories) {
-    if (out.makespan_s > tr.knots.back().t + 1e-12) {
+  for (RobotTrajectory& tr : out) {
+    if (makespan > tr.knots.back().t + 1e-12) {
       TrajectoryKnot rest = tr.knots.back();
-      rest.t = out.makespan_s;
+      rest.t = makespan;
       rest.qd.setZero();
       tr.knots.push_back(rest);
     }
   }
+  return out;
+}
+
+}  // namespace
+
+Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
+                      const std::vector<GeoSegment>& segments, const RetimeOptions& options,
+                      const RunContext* log, MotionScene* scene) {
+  const int n_robots = static_cast<int>(world.robots.size());
+  const int n_seg = static_cast<int>(segments.size());
+  for (const GeoSegment& s : segments) {
+    if (s.waypoints.empty()) return Fail(ErrorCode::kInvalidInput, "a motion segment is empty");
+    for (int r : s.robots) {
+      if (r < 0 || r >= n_robots) {
+        return Fail(ErrorCode::kInvalidInput, "a motion segment names robot " + std::to_string(r));
+      }
+    }
+  }
+  if (static_cast<int>(plan.initial.q.size()) != n_robots) {
+    return Fail(ErrorCode::kInvalidInput, "the plan's robots do not match the world's");
+  }
+  if (!(options.resolution_rad > 0.0)) {
+    return Fail(ErrorCode::kInvalidInput, "the schedule's resolution must be positive");
+  }
+  Timing out;
+  std::vector<detail::TimedSegment> timed;
+  for (const GeoSegment& s : segments) timed.push_back(detail::TimeSegment(world, s));
+  for (const detail::TimedSegment& ts : timed) out.makespan_sequential_s += ts.duration;
+
+  detail::Scheduler scheduler(world, plan, segments, timed, options, log, scene);
+  detail::ScheduleStats stats;
+  auto slots = scheduler.Run(&stats);
+  if (!slots) return std::unexpected(slots.error());
+  out.candidates = stats.candidates;
+  out.checked_candidates = stats.checked;
+  out.check_samples = stats.samples;
+  for (const detail::Slot& slot : *slots) {
+    out.makespan_s = std::max(out.makespan_s, slot.end_s);
+    out.dependencies += slot.wait != detail::WaitKind::kNone;
+    out.collision_waits += slot.wait == detail::WaitKind::kCollision;
+  }
+
+  std::vector<int> order(n_seg);
+  for (int j = 0; j < n_seg; ++j) order[j] = j;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return (*slots)[a].start_s < (*slots)[b].start_s; });
+  std::vector<int> position(n_seg);
+  for (int k = 0; k < n_seg; ++k) position[order[k]] = k;
+  out.trajectories = Trajectories(plan, segments, timed, *slots, order, out.makespan_s);
 
   // Segments and actions.
   const int n_actions = static_cast<int>(plan.actions.size());
@@ -258,25 +265,31 @@ Result<Timing> Retime(const TaskWorld& world, const Plan& plan,
   out.action_end_s.assign(n_actions, 0.0);
   for (int j : order) {
     const GeoSegment& s = segments[j];
+    const detail::Slot& slot = (*slots)[j];
     MotionSegment m;
     m.kind = std::string(ToString(s.kind));
     m.action = s.action;
     m.robots = s.robots;
     m.objects = s.objects;
-    m.start_s = start[j];
-    m.end_s = end[j];
+    m.start_s = slot.start_s;
+    m.end_s = slot.end_s;
+    m.wait = kWaitNames[static_cast<int>(slot.wait)];
+    m.wait_segment = slot.wait_on >= 0 ? position[slot.wait_on] : -1;
     out.segments.push_back(std::move(m));
     if (s.action >= 0 && s.action < n_actions && s.main) {
-      out.action_start_s[s.action] = std::min(out.action_start_s[s.action], start[j]);
-      if (s.kind == SegmentKind::kGrip) out.action_end_s[s.action] = end[j];
+      out.action_start_s[s.action] = std::min(out.action_start_s[s.action], slot.start_s);
+      if (s.kind == SegmentKind::kGrip) out.action_end_s[s.action] = slot.end_s;
     }
   }
   for (int i = 0; i < n_actions; ++i) {
     if (!std::isfinite(out.action_start_s[i])) out.action_start_s[i] = out.action_end_s[i];
   }
-  out.segment_start_s = start;
-  out.segment_end_s = end;
-  for (const TimedSegment& ts : timed) out.segment_stretch.push_back(ts.stretch);
+  for (const detail::Slot& slot : *slots) {
+    out.segment_start_s.push_back(slot.start_s);
+    out.segment_end_s.push_back(slot.end_s);
+    out.segment_concurrent.push_back(slot.concurrent ? 1 : 0);
+  }
+  for (const detail::TimedSegment& ts : timed) out.segment_stretch.push_back(ts.stretch);
   return out;
 }
 

@@ -21,9 +21,14 @@ namespace wrap {
 namespace detail {
 
 Result<std::vector<GeoSegment>> SegmentBuilder::Run() {
-  auto scene = MotionScene::Build(w_);
-  if (!scene) return std::unexpected(scene.error());
-  scene_ = std::move(*scene);
+  // The caller's scene when it keeps one (cells built once for all its calls), else our own.
+  std::optional<MotionScene>& slot = scene_holder_ ? *scene_holder_ : own_scene_;
+  if (!slot) {
+    auto scene = MotionScene::Build(w_);
+    if (!scene) return std::unexpected(scene.error());
+    slot = std::move(*scene);
+  }
+  scene_ = &*slot;
   rng_.seed(Mix(seed_, 0x6d6f74));
   const int n_robots = static_cast<int>(w_.robots.size());
   if (static_cast<int>(plan_.initial.q.size()) != n_robots) {
@@ -375,17 +380,17 @@ bool SegmentBuilder::KeyframeAccepts(int robot, const JointVector& q, const Keyf
   }
   std::vector<JointVector> qs = kf.q;
   qs[robot] = q;
-  if (!scene_.Set(at, opening_, qs, mating)) return false;
+  if (!scene_->Set(at, opening_, qs, mating)) return false;
   CollisionResult hit;
-  if (scene_.cell().InCollision(&hit)) {
+  if (scene_->cell().InCollision(&hit)) {
     if (ctx_.Logs("motion")) {
-      ctx_.Log("motion", StrFormat("keyframe: %s", scene_.cell().Describe(hit.first).c_str()));
+      ctx_.Log("motion", StrFormat("keyframe: %s", scene_->cell().Describe(hit.first).c_str()));
     }
     return false;
   }
   DistanceRequest request;
   request.upper_bound_m = 0.02;
-  return scene_.cell().MinRobotClearance(request).distance >= opt_.skills.robot_clearance_m;
+  return scene_->cell().MinRobotClearance(request).distance >= opt_.skills.robot_clearance_m;
 }
 
 bool SegmentBuilder::StageAccepts(int robot, int action, bool from_approach,
@@ -429,7 +434,7 @@ bool SegmentBuilder::Return(int action, int robot, const JointVector& goal, bool
   const double saved = opening_[robot];
   opening_[robot] = -1.0;
   if (!SetScene(opening_)) return false;
-  if (scene_.Collides(std::vector<int>{robot})) opening_[robot] = saved;
+  if (scene_->Collides(std::vector<int>{robot})) opening_[robot] = saved;
   return Free(action, main, {robot}, {goal}, {});
 }
 
@@ -448,8 +453,9 @@ Result<std::vector<GeoSegment>> PlanGeometricMotion(const TaskWorld& world, Plan
                                                     const MotionOptions& options,
                                                     const MotionRequest& request,
                                                     MotionCache& cache, RunContext& ctx,
-                                                    MotionFailure* failure) {
-  detail::SegmentBuilder builder(world, plan, options, request, cache, ctx, failure);
+                                                    MotionFailure* failure,
+                                                    std::optional<MotionScene>* scene) {
+  detail::SegmentBuilder builder(world, plan, options, request, cache, ctx, failure, scene);
   return builder.Run();
 }
 

@@ -43,10 +43,17 @@ struct GeoSegment {
   /// velocities / slow, accelerations / slow^2): set where an object's inertia would load its
   /// gripper beyond the limits (see PlanMotion).
   double slow = 1.0;
+  /// Scheduled only once everything before it has ended (the trajectory check refused it
+  /// running beside others: see PlanMotion).
+  bool after_all = false;
   /// World boxes swept by its robots' bodies and what they carry, and of its objects, grown by
   /// the sampling bound, per body: [0] the whole sweep, then the sweeps of consecutive runs of
   /// samples. Two segments whose boxes do not meet can run at the same time.
   std::vector<std::vector<Aabb>> sweep;
+  /// Per chunk of `sweep` (sweep[b][c + 1]): the path parameter of its first sample, k + s on
+  /// the straight piece from waypoint k to k + 1 (s in [0, 1]); a chunk lasts until the next
+  /// one starts. The schedule tells from it when the chunk's boxes are swept.
+  std::vector<double> sweep_u;
 };
 
 /// An object that one robot carries alone: its mass, its centre of mass in the grasp (TCP)
@@ -71,13 +78,16 @@ double LoadRatio(const SoleLoad& load, const Mat3& R_WG, const Vec3& accel_W = V
 /// joints at that keyframe and the following ones where it stood still (validate the plan again).
 /// On success the segments in execution order (the plan's order; the schedule may overlap them);
 /// otherwise `failure` says which segment failed. `cache` keeps solved free paths between calls
-/// for the same plan. Deterministic for a given request.seed when no path search runs out of time.
+/// for the same plan. `scene` (may be null) keeps a motion scene of `world` between calls: built
+/// on the first (when empty), its cells are not built again (MotionScene::Set poses it afresh
+/// each time). Deterministic for a given request.seed when no path search runs out of time.
 /// Fails with kCancelled when ctx is cancelled and kInvalidInput when the plan does not fit the
 /// world.
 Result<std::vector<GeoSegment>> PlanGeometricMotion(const TaskWorld& world, Plan& plan,
                                                     const MotionOptions& options,
                                                     const MotionRequest& request,
                                                     MotionCache& cache, RunContext& ctx,
-                                                    MotionFailure* failure);
+                                                    MotionFailure* failure,
+                                                    std::optional<MotionScene>* scene = nullptr);
 
 }  // namespace wrap

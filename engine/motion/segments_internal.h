@@ -130,7 +130,7 @@ class SegmentBuilder {
  public:
   SegmentBuilder(const TaskWorld& world, Plan& plan, const MotionOptions& options,
                  const MotionRequest& request, MotionCache& cache, RunContext& ctx,
-                 MotionFailure* failure)
+                 MotionFailure* failure, std::optional<MotionScene>* scene)
       : w_(world),
         plan_(plan),
         opt_(options),
@@ -138,7 +138,8 @@ class SegmentBuilder {
         seed_(request.seed),
         cache_(cache),
         ctx_(ctx),
-        failure_(failure) {}
+        failure_(failure),
+        scene_holder_(scene) {}
 
   Result<std::vector<GeoSegment>> Run();
 
@@ -373,7 +374,9 @@ class SegmentBuilder {
   RunContext& ctx_;
   MotionFailure* failure_;
 
-  MotionScene scene_;
+  std::optional<MotionScene>* scene_holder_ = nullptr;  // the caller's scene, if it keeps one
+  std::optional<MotionScene> own_scene_;
+  MotionScene* scene_ = nullptr;  // one of them (Run)
   std::vector<PlanState> states_;
   PlanState state_;
   std::vector<JointVector> cur_;

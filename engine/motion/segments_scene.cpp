@@ -19,7 +19,7 @@ Result<void> SegmentBuilder::SetScene(const std::vector<double>& openings,
   // Objects still where they were picked from touch the table until they are lifted.
   std::vector<int> on_table = table_ok;
   on_table.insert(on_table.end(), grounded_.begin(), grounded_.end());
-  return scene_.Set(state_, openings, cur_, mating, on_table, gripper_ok);
+  return scene_->Set(state_, openings, cur_, mating, on_table, gripper_ok);
 }
 
 bool SegmentBuilder::Fail(int action, SegmentKind kind, bool suspend, const std::string& message,
@@ -43,7 +43,7 @@ FailureScene SegmentBuilder::CellNow() {
   FailureScene scene;
   scene.q = cur_;
   scene.X_WP.resize(w_.num_parts);
-  for (int p = 0; p < w_.num_parts; ++p) scene.X_WP[p] = scene_.cell().object_pose(p);
+  for (int p = 0; p < w_.num_parts; ++p) scene.X_WP[p] = scene_->cell().object_pose(p);
   return scene;
 }
 
@@ -98,25 +98,29 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
   constexpr int kChunk = 6;
   if (!SetScene(seg.openings)) return;
   std::vector<std::vector<Aabb>> sweep;  // per body: [0] all, then chunks
+  std::vector<double> sweep_u;           // per chunk: the path parameter of its first sample
   std::vector<Aabb> sample;
   int count = 0;
+  double u = 0.0;  // the path parameter of the sample
   auto merge = [](Aabb& into, const Aabb& b) {
     into.min = into.min.cwiseMin(b.min);
     into.max = into.max.cwiseMax(b.max);
   };
   auto add = [&] {
     sample.clear();
-    for (int r : seg.robots) scene_.AppendBoxes(r, sample);
+    for (int r : seg.robots) scene_->AppendBoxes(r, sample);
     for (int node : seg.objects) {
-      if (state_.objects.count(node)) scene_.AppendObjectBoxes(node, sample);
+      if (state_.objects.count(node)) scene_->AppendObjectBoxes(node, sample);
     }
     if (sweep.size() != sample.size()) {  // first sample (or a body appeared: start over)
       sweep.assign(sample.size(), {});
       for (size_t b = 0; b < sample.size(); ++b) sweep[b] = {sample[b], sample[b]};
+      sweep_u = {0.0};  // (from the start: the samples before a restart are not kept)
       count = 1;
       return;
     }
     const bool fresh = count % kChunk == 0;
+    if (fresh) sweep_u.push_back(u);
     for (size_t b = 0; b < sample.size(); ++b) {
       merge(sweep[b][0], sample[b]);
       if (fresh) {
@@ -128,7 +132,7 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
     ++count;
   };
   const auto& wp = seg.waypoints;
-  for (size_t i = 0; i < seg.robots.size(); ++i) scene_.SetRobot(seg.robots[i], wp[0][i]);
+  for (size_t i = 0; i < seg.robots.size(); ++i) scene_->SetRobot(seg.robots[i], wp[0][i]);
   add();
   for (size_t k = 1; k < wp.size(); ++k) {
     double l1 = 0.0;
@@ -136,8 +140,9 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
     const int steps = std::max(1, static_cast<int>(std::ceil(l1 / kSweepStep)));
     for (int s = 1; s <= steps; ++s) {
       const double t = static_cast<double>(s) / steps;
+      u = static_cast<double>(k - 1) + t;
       for (size_t i = 0; i < seg.robots.size(); ++i) {
-        scene_.SetRobot(seg.robots[i], wp[k - 1][i] + t * (wp[k][i] - wp[k - 1][i]));
+        scene_->SetRobot(seg.robots[i], wp[k - 1][i] + t * (wp[k][i] - wp[k - 1][i]));
       }
       add();
     }
@@ -149,6 +154,7 @@ void SegmentBuilder::Sweep(GeoSegment& seg) {
     }
   }
   seg.sweep = std::move(sweep);
+  seg.sweep_u = std::move(sweep_u);
 }
 
 std::vector<double> SegmentBuilder::SceneKey() const {

@@ -78,7 +78,7 @@ bool SegmentBuilder::EndClear(int robot, const JointVector& q_end,
   const JointVector start = cur_[robot];
   cur_[robot] = q_end;
   const bool clear =
-      SetScene(openings).has_value() && !scene_.Collides(std::span<const int>(&robot, 1));
+      SetScene(openings).has_value() && !scene_->Collides(std::span<const int>(&robot, 1));
   cur_[robot] = start;
   // Back to the scene the straight move is checked in.
   return SetScene(openings, {}, {}, gripper_ok).has_value() && clear;
@@ -396,7 +396,7 @@ bool SegmentBuilder::HoverAbove(int action, Keyframe& goal, std::vector<int>& ho
         continue;
       }
       // The way down may touch the table and the base (the slide's contacts).
-      if (!scene_.Set(at, opening_, goal.q, {{m_node, b_node}}, {m_node})) return false;
+      if (!scene_->Set(at, opening_, goal.q, {{m_node, b_node}}, {m_node})) return false;
       if (!PathClear(holders, path)) {
         why = last_hit_;
         continue;

@@ -157,6 +157,8 @@ class MotionQueue {
   // collides, a goal in collision, or every effort spent) are not taken by later task plans;
   // without it a task search that does not depend on its seed would make the same plan again.
   std::set<std::uint64_t> banned_;
+  // The motion scene of every attempt: its collision cells are built once for the run.
+  std::optional<MotionScene> scene_;
 };
 
 Result<void> MotionQueue::Enqueue(Plan plan) {
@@ -228,7 +230,7 @@ Result<std::optional<Plan>> MotionQueue::TryMotion() {
                     " suspensions so far)");
   // The path searches are seeded by the task plan's seed, xor "MP" (motion planning).
   const MotionRequest request{.effort = c.effort, .seed = c.plan.stats.seed ^ 0x4d50ULL};
-  auto attempt = PlanMotion(world_, c.plan, motion_, request, c.cache, ctx_);
+  auto attempt = PlanMotion(world_, c.plan, motion_, request, c.cache, ctx_, &scene_);
   if (!attempt) return std::unexpected(attempt.error());
   t_mp_ += attempt->t_mp_s;
   t_retime_ += attempt->t_retime_s;

@@ -156,6 +156,15 @@ struct MotionSegment {
   std::vector<int> objects;
   double start_s = 0.0;  ///< Start [s].
   double end_s = 0.0;    ///< End [s].
+  /// What its start waited for: "none" (nothing: it starts at 0), "robot" (it starts when
+  /// `wait_segment`, the previous segment of one of its robots, ends), "object" (when
+  /// `wait_segment`, an earlier segment on one of its objects, ends), "collision" (it was ready
+  /// earlier, but its timed motion, or its robots' rest afterwards, would have collided with
+  /// `wait_segment`'s robots or with an object that segment moves); empty: not recorded (plans
+  /// written before the schedule said).
+  std::string wait;
+  /// The segment waited for (index into Plan::segments), -1 for none.
+  int wait_segment = -1;
 };
 
 /// Statistics of a planner run (the paper's breakdown table and search counters).
@@ -211,12 +220,12 @@ struct PlanStats {
 /// Two parts that touch in the assembly, as the geometry checks found them (the project's contact
 /// graph, recorded with the plan for viewers).
 struct PlanContact {
-  int part_a = -1;                    ///< Part index (Plan::parts), a < b.
-  int part_b = -1;                    ///< The other part.
-  double distance_m = 0.0;            ///< Closest distance of the surfaces (0: they meet) [m].
-  double area_m2 = 0.0;               ///< Area within the contact tolerance [m^2].
-  Vec3 centroid_A = Vec3::Zero();     ///< Centre of that area, assembly frame [m].
-  Vec3 extent_min_A = Vec3::Zero();   ///< Its bounding box, assembly frame [m].
+  int part_a = -1;                   ///< Part index (Plan::parts), a < b.
+  int part_b = -1;                   ///< The other part.
+  double distance_m = 0.0;           ///< Closest distance of the surfaces (0: they meet) [m].
+  double area_m2 = 0.0;              ///< Area within the contact tolerance [m^2].
+  Vec3 centroid_A = Vec3::Zero();    ///< Centre of that area, assembly frame [m].
+  Vec3 extent_min_A = Vec3::Zero();  ///< Its bounding box, assembly frame [m].
   Vec3 extent_max_A = Vec3::Zero();
   std::vector<std::pair<Vec3, double>> normals;  ///< Unit normal out of b into a, with its area.
 };

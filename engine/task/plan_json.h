@@ -12,7 +12,15 @@
 //                 "placement": {"placement", "slot", "yaw"}      (place, when known),
 //                 "milestone": m, "start_s": t0, "end_s": t1      (times once retimed),
 //                 "keyframe": KEYFRAME, "approach": KEYFRAME      (assemble, when known),
-//                 "description": "ur5e_a picks 'seat' (grasp 3)" (written, not read)}]}
+//                 "description": "ur5e_a picks 'seat' (grasp 3)" (written, not read)}],
+//    with motion:
+//    "trajectories": [{"robot": name, "t": [...], "q": [[...]], "qd": [[...]],
+//                      "opening_m": [...]}],
+//    "segments": [{"kind": "free", "action": i, "robots": [names], "objects": [node names],
+//                  "start_s": t0, "end_s": t1,
+//                  "wait": "none|robot|object|collision", "wait_segment": k  (absent in
+//                  plans written before the schedule recorded its waits)}],
+//    "contacts": [...]}
 //   KEYFRAME = {"q": {robot name: [joint values]},
 //               "objects": [{"name": node name, "X_WA": POSE, "resting": bool}]}
 //   POSE = {"xyz": [x, y, z], "rpy": [roll, pitch, yaw]}  (m, rad, as in project files)

@@ -268,9 +268,11 @@ class PlanReader {
     }
     return tr;
   }
-  MotionSegment ReadSegment(const json& e, const std::string& at) {
+  // A segment of `count` (its wait names one of them).
+  MotionSegment ReadSegment(const json& e, const std::string& at, size_t count) {
     ExpectObject(e, at);
-    CheckKeys(e, at, {"kind", "action", "robots", "objects", "start_s", "end_s"});
+    CheckKeys(e, at,
+              {"kind", "action", "robots", "objects", "start_s", "end_s", "wait", "wait_segment"});
     MotionSegment m;
     m.kind = String(e, at, "kind");
     m.action = Int(e, at, "action", -1, static_cast<int>(plan_.actions.size()) - 1);
@@ -285,6 +287,15 @@ class PlanReader {
     m.start_s = NonNegative(e, at, "start_s");
     m.end_s = NonNegative(e, at, "end_s");
     if (m.end_s < m.start_s) Bad(Join(at, "end_s"), "ends before it starts");
+    // Absent in plans written before the schedule recorded its waits.
+    if (Find(e, "wait")) {
+      m.wait = String(e, at, "wait");
+      if (m.wait != "none" && m.wait != "robot" && m.wait != "object" && m.wait != "collision") {
+        Bad(Join(at, "wait"),
+            "unknown wait '" + m.wait + "' (known: none, robot, object, collision)");
+      }
+      m.wait_segment = Int(e, at, "wait_segment", -1, static_cast<int>(count) - 1);
+    }
     return m;
   }
 
@@ -509,7 +520,8 @@ Plan ReadPlan(const json& root) {
   if (const json* segments = Find(root, "segments")) {
     ExpectArray(*segments, "segments");
     for (size_t i = 0; i < segments->size(); ++i) {
-      plan.segments.push_back(reader.ReadSegment((*segments)[i], Index("segments", i)));
+      plan.segments.push_back(
+          reader.ReadSegment((*segments)[i], Index("segments", i), segments->size()));
     }
   }
   if (const json* contacts = Find(root, "contacts")) {

@@ -117,8 +117,13 @@ ojson SegmentJson(const Plan& plan, const MotionSegment& m) {
   ojson robots = ojson::array(), objects = ojson::array();
   for (int r : m.robots) robots.push_back(NameOr(plan.robots, r));
   for (int o : m.objects) objects.push_back(NameOr(plan.nodes, o));
-  return ojson{{"kind", m.kind},     {"action", m.action},   {"robots", robots},
-               {"objects", objects}, {"start_s", m.start_s}, {"end_s", m.end_s}};
+  ojson j{{"kind", m.kind},     {"action", m.action},   {"robots", robots},
+          {"objects", objects}, {"start_s", m.start_s}, {"end_s", m.end_s}};
+  if (!m.wait.empty()) {
+    j["wait"] = m.wait;
+    j["wait_segment"] = m.wait_segment;
+  }
+  return j;
 }
 
 ojson ActionJson(const Plan& plan, const PlanAction& a, size_t index) {

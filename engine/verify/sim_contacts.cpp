@@ -89,7 +89,7 @@ ContactRules Simulator::Rules(double t) const {
 }
 
 // The action a robot was working on at t: that of its motion segment under way (or just
-// ended: checks come every few steps), else the action under way.
+// ended: checks come every few steps); -1 when it was idle.
 int Simulator::ActionOfRobot(int r, double t) const {
   const double slack = 2.0 * options_.sample_every * model_->opt.timestep;
   for (const MotionSegment& s : plan_.segments) {
@@ -98,7 +98,7 @@ int Simulator::ActionOfRobot(int r, double t) const {
       return s.action;
     }
   }
-  return CurrentAction();
+  return -1;
 }
 
 // Collisions at t, when something moved enough since the last check (or an action happened).
@@ -176,7 +176,14 @@ void Simulator::BlameCollision(const CollisionHit& h, double t) {
       detail += " (a part the robot neither holds nor is grasping or releasing)";
     }
   }
-  Failed(robot >= 0 ? ActionOfRobot(robot, t) : CurrentAction(), "collision", detail, t);
+  // The action of a robot of the collision (or of a holder of a part of it) that was moving
+  // then: robots work at the same time, so the next action to happen may be another's.
+  int action = -1;
+  for (int r : {h.robot_a, h.robot_b, h.part_a >= 0 ? holder(h.part_a) : -1,
+                h.part_b >= 0 ? holder(h.part_b) : -1}) {
+    if (r >= 0 && action < 0) action = ActionOfRobot(r, t);
+  }
+  Failed(action >= 0 ? action : CurrentAction(), "collision", detail, t);
 }
 
 // The two inputs of an insertion under way where MuJoCo has them (the collision rules let them

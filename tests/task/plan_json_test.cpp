@@ -302,6 +302,57 @@ TEST(PlanJson, UtilisationRoundTripsAndIsChecked) {
       << bad.error().message;
 }
 
+// Motion segments say what each waited for; plans written before they did still read (no
+// wait); a wait that is not a known one or names no segment is refused.
+TEST(PlanJson, SegmentWaitsRoundTripAndOldPlansStillRead) {
+  Plan plan = StoolPlan();
+  for (size_t r = 0; r < plan.robots.size(); ++r) {
+    RobotTrajectory tr;
+    tr.robot = static_cast<int>(r);
+    TrajectoryKnot k;
+    k.q = plan.initial.q[r];
+    k.qd = JointVector::Zero(k.q.size());
+    tr.knots.push_back(k);
+    plan.trajectories.push_back(tr);
+  }
+  MotionSegment first{"free", 0, {2}, {1}, 0.0, 1.5, "none", -1};
+  MotionSegment second{"free", 0, {0}, {}, 1.25, 2.0, "collision", 0};
+  MotionSegment third{"approach", 0, {2}, {1}, 1.5, 2.25, "robot", 0};
+  plan.segments = {first, second, third};
+  const std::string text = SerializePlan(plan);
+  auto parsed = ParsePlan(text, "plan.json");
+  ASSERT_TRUE(parsed.has_value()) << parsed.error().message;
+  ASSERT_EQ(parsed->segments.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(parsed->segments[k].wait, plan.segments[k].wait);
+    EXPECT_EQ(parsed->segments[k].wait_segment, plan.segments[k].wait_segment);
+  }
+  const json doc = json::parse(text);
+  EXPECT_EQ(doc["segments"][1]["wait"], "collision");
+  EXPECT_EQ(doc["segments"][1]["wait_segment"], 0);
+  json old = doc;
+  for (json& seg : old["segments"]) {
+    seg.erase("wait");
+    seg.erase("wait_segment");
+  }
+  auto before = ParsePlan(old.dump(), "plan.json");
+  ASSERT_TRUE(before.has_value()) << before.error().message;
+  EXPECT_EQ(before->segments[1].wait, "");
+  EXPECT_EQ(before->segments[1].wait_segment, -1);
+  json unknown = doc;
+  unknown["segments"][1]["wait"] = "lunch";
+  auto bad = ParsePlan(unknown.dump(), "plan.json");
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find("segments[1].wait: unknown wait 'lunch'"), std::string::npos)
+      << bad.error().message;
+  json beyond = doc;
+  beyond["segments"][2]["wait_segment"] = 3;
+  bad = ParsePlan(beyond.dump(), "plan.json");
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find("segments[2].wait_segment"), std::string::npos)
+      << bad.error().message;
+}
+
 TEST(PlanJson, DocumentLayout) {
   const json doc = json::parse(SerializePlan(StoolPlan()));
   std::vector<std::string> keys;
