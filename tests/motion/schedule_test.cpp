@@ -34,9 +34,9 @@ class Schedule : public ::testing::Test {
       plan_.robots.push_back(r.name);
       plan_.initial.q.push_back(r.home);
     }
-    for (int p = 0; p < w_->num_parts; ++p) {
-      plan_.parts.push_back(w_->tree->nodes[p].name);
-      plan_.initial.objects.push_back({p, w_->initial_X_WA[p], true});
+    for (int part = 0; part < w_->num_parts; ++part) {
+      plan_.parts.push_back(w_->tree->nodes[part].name);
+      plan_.initial.objects.push_back({part, w_->initial_X_WA[part], true});
     }
     for (const AssemblyNode& n : w_->tree->nodes) plan_.nodes.push_back(n.name);
   }
