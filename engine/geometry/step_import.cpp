@@ -589,6 +589,11 @@ Result<StepAssembly> ReadStep(const fs::path& path, const StepTessellation& tess
   reader.SetMatMode(Standard_False);
   reader.SetViewMode(Standard_False);
   reader.SetSHUOMode(Standard_False);
+  // Before OpenCASCADE reads it: its reader follows an oriented edge's missing or circular edge
+  // until the stack overflows.
+  if (const std::string broken = detail::FindBrokenReference(path); !broken.empty()) {
+    return Fail(ErrorCode::kInvalidInput, "STEP file " + Quote(file) + " is damaged: " + broken);
+  }
   if (reader.ReadFile(file.c_str()) != IFSelect_RetDone) {
     const std::string why = OcctSession::Messages("OpenCASCADE's reader failed");
     return Fail(ErrorCode::kInvalidInput, "cannot parse STEP file " + Quote(file) + ": " +

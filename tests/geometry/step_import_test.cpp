@@ -349,10 +349,18 @@ TEST_F(StepImportTest, TruncatedFile) {
         WriteText("cut.step", text.substr(0, static_cast<size_t>(keep * text.size())));
     ExpectError(ImportStep(cut), ErrorCode::kInvalidInput, cut, {"truncated"});
   }
-  // Cut in the middle but with the end marker put back: the parser names the line.
+  // Cut in the middle but with the end marker put back: the entities left refer to ones cut off.
   const fs::path spliced =
       WriteText("spliced.step", text.substr(0, text.size() / 2) + "\nENDSEC;\nEND-ISO-10303-21;\n");
   ExpectError(ImportStep(spliced), ErrorCode::kInvalidInput, spliced,
+              {"is damaged: entity #", "which the file does not define"});
+  // A record that does not parse, its references intact: the parser names the line.
+  std::string garbled = text;
+  const size_t point = garbled.find("CARTESIAN_POINT(");
+  ASSERT_NE(point, std::string::npos);
+  garbled.replace(point, 16, "CARTESIAN_POINT((");
+  const fs::path unparsed = WriteText("garbled.step", garbled);
+  ExpectError(ImportStep(unparsed), ErrorCode::kInvalidInput, unparsed,
               {"Line ", "near entity #", "syntax"});
 }
 
@@ -367,6 +375,36 @@ TEST_F(StepImportTest, FileWithoutSolids) {
   ASSERT_FALSE(a.has_value());
   EXPECT_EQ(a.error().code, ErrorCode::kInvalidInput);
   EXPECT_NE(a.error().message.find(points.string()), std::string::npos) << a.error().message;
+}
+
+// References that form a cycle (an edge that is its own edge; a loop through two entities) or
+// name an entity the file lacks are refused before OpenCASCADE, which followed such an edge until
+// the stack overflowed (found by fuzz_step).
+// A '#' inside a string or comment is not a reference.
+TEST_F(StepImportTest, BrokenEntityReferencesAreRefused) {
+  const std::string head =
+      "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('#1 in a string'),'2;1');\n"
+      "FILE_NAME('p','',(''),(''),'','','');\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\nENDSEC;\n"
+      "DATA;\n#1=CARTESIAN_POINT('it''s #2; not a reference',(0.,0.,0.));\n/* #3 -> #3 */\n";
+  const std::string tail = "ENDSEC;\nEND-ISO-10303-21;\n";
+  const fs::path self = WriteText(
+      "self.step", head + "#2=VERTEX_POINT('',#1);\n#3=ORIENTED_EDGE('',*,*,#3,.T.);\n" + tail);
+  ExpectError(ImportStep(self), ErrorCode::kInvalidInput, self, {"cycle (#3 -> #3)"});
+  const fs::path loop = WriteText(
+      "loop.step", head +
+                       "#2=EDGE_LOOP('',(#4));\n#3=VERTEX_POINT('',#1);\n"
+                       "#4=ORIENTED_EDGE('',*,*,#5,.T.);\n#5=ORIENTED_EDGE('',*,*,#4,.F.);\n" +
+                       tail);
+  ExpectError(ImportStep(loop), ErrorCode::kInvalidInput, loop, {"cycle (#4 -> #5 -> #4)"});
+  const fs::path dangling = WriteText(
+      "dangling.step", head + "#2=VERTEX_POINT('',#1);\n#3=ORIENTED_EDGE('',*,*,#9,.T.);\n" + tail);
+  ExpectError(ImportStep(dangling), ErrorCode::kInvalidInput, dangling,
+              {"entity #3 refers to #9, which the file does not define"});
+  // Without a cycle the same text goes on to OpenCASCADE (and has no solid).
+  const fs::path fine = WriteText("fine.step", head + "#2=VERTEX_POINT('',#1);\n" + tail);
+  auto a = ImportStep(fine);
+  ASSERT_FALSE(a.has_value());
+  EXPECT_EQ(a.error().message.find("cycle"), std::string::npos) << a.error().message;
 }
 
 TEST_F(StepImportTest, SolidThatDoesNotMeshClosed) {

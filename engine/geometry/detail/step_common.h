@@ -15,6 +15,12 @@ namespace wrap::detail {
 /// "END-ISO-10303-21;" (else: truncated). Errors name the file.
 Result<void> CheckStepFile(const std::filesystem::path& path);
 
+/// What is wrong with the entity references of a STEP file's DATA section, or empty: a reference
+/// to an entity the file does not define ("entity #5 refers to #9, which the file does not
+/// define"), or the first cycle ("its entities refer to each other in a cycle (#4 -> #5 -> #4)");
+/// a well-formed file has neither.
+std::string FindBrokenReference(const std::filesystem::path& path);
+
 /// A tessellated solid must be closed and enclose a volume: fails naming `what` otherwise.
 /// Inward-facing triangles (negative volume) are turned outward.
 Result<TriangleMesh> CheckClosedSolid(TriangleMesh mesh, const std::string& what);
