@@ -20,6 +20,15 @@
 
 namespace wrap::detail {
 
+/// Times closer than this are the same moment [s].
+inline constexpr double kEps = 1e-9;
+
+/// Boxes a and b meet once each is grown by `grow` on every side [m].
+inline bool Overlap(const Aabb& a, const Aabb& b, double grow) {
+  return (a.min.array() <= b.max.array() + grow).all() &&
+         (b.min.array() <= a.max.array() + grow).all();
+}
+
 // A time-optimal rest-to-rest trapezoid in the path parameter s in [0, 1] of one straight piece.
 struct Profile {
   double t_acc = 0.0;    // acceleration phase [s]

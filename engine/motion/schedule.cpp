@@ -17,13 +17,6 @@ namespace wrap::detail {
 
 namespace {
 
-constexpr double kEps = 1e-9;  // [s]
-
-bool Overlap(const Aabb& a, const Aabb& b, double grow) {
-  return (a.min.array() <= b.max.array() + grow).all() &&
-         (b.min.array() <= a.max.array() + grow).all();
-}
-
 // The spans where some body of `a` and some body of `b` may come within `grow` of each other:
 // for each pair of bodies whose whole boxes meet, the chunks of both that overlap in time and
 // whose boxes meet.

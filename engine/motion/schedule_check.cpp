@@ -11,17 +11,6 @@
 
 namespace wrap::detail {
 
-namespace {
-
-constexpr double kEps = 1e-9;  // [s]
-
-bool Overlap(const Aabb& a, const Aabb& b, double grow) {
-  return (a.min.array() <= b.max.array() + grow).all() &&
-         (b.min.array() <= a.max.array() + grow).all();
-}
-
-}  // namespace
-
 void Scheduler::RobotAt(int r, double tau, int j, double t, JointVector& q, double& opening) const {
   auto opening_in = [&](int k) {
     const std::vector<double>& o = segs_[k].openings;
