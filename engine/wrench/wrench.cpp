@@ -380,11 +380,8 @@ Result<WrenchCheck> WrenchChecker::Impl::Compute(const StepConfiguration& config
       worst = utilisation;
       out.worst_vertex = v;
     }
-    if (failing && StopAfterFailure(v)) {
-      out.worst_vertex = v;  // the vertex the reason explains
-      worst = utilisation;
-      break;
-    }
+    // A failing vertex is the worst so far (every earlier one passed), so the reason explains it.
+    if (failing && StopAfterFailure(v)) break;
   }
   out.utilisation = worst < 0.0 ? 0.0 : worst;
   return Finish(config, query, p_WO, vertices, std::move(out), std::string(ToString(gate)));
@@ -538,7 +535,7 @@ Result<std::vector<double>> WrenchChecker::Impl::SolveMatingVertices(
       for (int j = 0; j < n; ++j) hold[j] = solution.x[j];
     }
     if (failing) ++out.failing_vertex_count;
-    if (utilisation > worst || (failing && options.first_failure_suffices)) {
+    if (utilisation > worst) {
       worst = utilisation;
       out.worst_vertex = v;
       worst_hold = hold;
