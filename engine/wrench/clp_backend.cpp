@@ -50,33 +50,35 @@ class ClpBackend final : public LpBackend {
       upper_[j] = std::isinf(problem.upper[j]) ? COIN_DBL_MAX : problem.upper[j];
     }
     try {
+      // Clp 1.17's scaled dual simplex is wrong now and then: it calls an unbounded problem
+      // infeasible, stops without an answer on a planner's LP that has one, or stops at a load
+      // factor of 0 where the unscaled primal simplex (and our dense simplex) balance the load
+      // (questions recorded from the planner's searches, tests/wrench/data). So both run: two
+      // optima, the lower objective (a feasible point attains it); one answer, that one; else
+      // the primal's verdict on infeasible or unbounded, else the dual's.
       ClpSimplex model;
       Load(problem, model);
       model.dual();
-      solution.iterations = model.numberIterations();
-      if (model.status() != 0) {
-        // Clp 1.17's scaled dual simplex sometimes calls an unbounded problem infeasible, or
-        // stops without an answer on a planner's LP that has one: confirm or replace its verdict
-        // with the unscaled primal simplex (kept unless that one fails too).
-        ClpSimplex check;
-        Load(problem, check);
-        check.scaling(0);
+      ClpSimplex check;
+      Load(problem, check);
+      check.scaling(0);
+      int primal_status = -1;  // -1: it threw
+      try {
         check.primal();
-        solution.iterations += check.numberIterations();
-        if (check.status() == 0) {
-          const double* x = check.primalColumnSolution();
-          for (int j = 0; j < n; ++j) solution.x[j] = x[j];
-          solution.objective = check.objectiveValue();
-          return solution.status = LpStatus::kOptimal;
-        }
-        if (check.status() == 1 || check.status() == 2) model.setProblemStatus(check.status());
+        primal_status = check.status();
+      } catch (...) {  // CoinError is not a std::exception.
       }
-      if (model.status() == 0 && BetterByPrimal(problem, model.objectiveValue(), solution)) {
-        return solution.status = LpStatus::kOptimal;
+      solution.iterations = model.numberIterations() + check.numberIterations();
+      const int dual_status = model.status();
+      if (dual_status == 0 && primal_status == 0) {
+        const double dual = model.objectiveValue();
+        const bool lower = check.objectiveValue() < dual - 1e-9 * (1.0 + std::abs(dual));
+        return Take(lower ? check : model, solution);
       }
-      switch (model.status()) {
-        case 0:
-          break;
+      if (dual_status == 0) return Take(model, solution);
+      if (primal_status == 0) return Take(check, solution);
+      const int status = primal_status == 1 || primal_status == 2 ? primal_status : dual_status;
+      switch (status) {
         case 1:
           return solution.status = LpStatus::kInfeasible;
         case 2:
@@ -86,10 +88,6 @@ class ClpBackend final : public LpBackend {
         default:
           return solution.status = LpStatus::kError;
       }
-      const double* x = model.primalColumnSolution();
-      for (int j = 0; j < n; ++j) solution.x[j] = x[j];
-      solution.objective = model.objectiveValue();
-      return solution.status = LpStatus::kOptimal;
     } catch (const std::exception&) {
       return solution.status = LpStatus::kError;
     } catch (...) {  // CoinError is not a std::exception.
@@ -98,27 +96,12 @@ class ClpBackend final : public LpBackend {
   }
 
  private:
-  // Clp's dual optimum can be wrong: on questions recorded from the planner's searches
-  // (tests/wrench/data) it stopped at a load factor of 0 where the unscaled primal simplex (and
-  // our dense simplex) balance the load. Both claim optimality; the lower objective is attained
-  // by a feasible point, so it is the right one. True when the primal's is lower (then in
-  // `solution`); a primal that fails or throws leaves the dual's answer.
-  bool BetterByPrimal(const LpProblem& problem, double dual_objective, LpSolution& solution) {
-    try {
-      ClpSimplex check;
-      Load(problem, check);
-      check.scaling(0);
-      check.primal();
-      solution.iterations += check.numberIterations();
-      const double better = dual_objective - 1e-9 * (1.0 + std::abs(dual_objective));
-      if (check.status() != 0 || !(check.objectiveValue() < better)) return false;
-      const double* x = check.primalColumnSolution();
-      for (int j = 0; j < problem.cols; ++j) solution.x[j] = x[j];
-      solution.objective = check.objectiveValue();
-      return true;
-    } catch (...) {  // CoinError is not a std::exception.
-      return false;
-    }
+  // The optimum `model` found, into `solution`.
+  static LpStatus Take(const ClpSimplex& model, LpSolution& solution) {
+    const double* x = model.primalColumnSolution();
+    for (std::size_t j = 0; j < solution.x.size(); ++j) solution.x[j] = x[j];
+    solution.objective = model.objectiveValue();
+    return solution.status = LpStatus::kOptimal;
   }
 
   void Load(const LpProblem& problem, ClpSimplex& model) const {
