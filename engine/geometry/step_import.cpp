@@ -67,6 +67,7 @@
 
 #include "core/file_io.h"
 #include "geometry/detail/step_common.h"
+#include "geometry/detail/step_isolation.h"
 #include "geometry/detail/vertex_welder.h"
 
 namespace wrap {
@@ -126,11 +127,16 @@ MessageCollector& Collector() {
   return *collector;
 }
 
+/// Whether OcctSession takes OcctMutex: not in an import's child process, which inherits it
+/// locked (detail::ImportInChild) and is its only thread.
+enum class Locking { kLock, kInheritedLock };
+
 /// OpenCASCADE for one read or write: the lock, a clean message list and an XCAF document that
 /// is closed again at the end.
 class OcctSession {
  public:
-  OcctSession() : lock_(OcctMutex()) {
+  explicit OcctSession(Locking locking = Locking::kLock) {
+    if (locking == Locking::kLock) lock_ = std::unique_lock(OcctMutex());
     Collector().Clear();
     app_ = XCAFApp_Application::GetApplication();
     app_->NewDocument("MDTV-XCAF", doc_);
@@ -153,7 +159,7 @@ class OcctSession {
   }
 
  private:
-  std::lock_guard<std::mutex> lock_;
+  std::unique_lock<std::mutex> lock_;
   Handle(XCAFApp_Application) app_;
   Handle(TDocStd_Document) doc_;
 };
@@ -571,9 +577,10 @@ Result<void> CheckTessellation(const StepTessellation& t, const std::string& fil
   return {};
 }
 
-Result<StepAssembly> ReadStep(const fs::path& path, const StepTessellation& tessellation) {
+Result<StepAssembly> ReadStep(const fs::path& path, const StepTessellation& tessellation,
+                              Locking locking) {
   const std::string file = path.string();
-  OcctSession session;
+  OcctSession session(locking);
   Interface_Static::SetCVal("xstep.cascade.unit", "MM");
   // Off: with it on, OpenCASCADE 7.6's ExpandSubShapes dereferences a null representation item
   // of a damaged file (found by fuzz_step; tests/fuzz/regressions/step). Parts are named by their
@@ -627,6 +634,27 @@ Result<StepAssembly> ReadStep(const fs::path& path, const StepTessellation& tess
   auto out = read.Run();
   if (out) out->unit = *unit;
   return out;
+}
+
+/// The checks that need no OpenCASCADE: the deflections, and the file's start and end.
+Result<void> CheckBeforeReading(const fs::path& path, const StepTessellation& tessellation) {
+  if (auto ok = CheckTessellation(tessellation, path.string()); !ok) return ok;
+  return detail::CheckStepFile(path);
+}
+
+/// ReadStep with OpenCASCADE's exceptions made errors.
+Result<StepAssembly> ReadStepGuarded(const fs::path& path, const StepTessellation& tessellation,
+                                     Locking locking) {
+  try {
+    return ReadStep(path, tessellation, locking);
+  } catch (const Standard_Failure& e) {
+    return Fail(ErrorCode::kInvalidInput, "cannot read STEP file " + Quote(path.string()) +
+                                              ": OpenCASCADE failed (" + e.DynamicType()->Name() +
+                                              ": " + e.GetMessageString() + ")");
+  } catch (const std::exception& e) {
+    return Fail(ErrorCode::kInvalidInput,
+                "cannot read STEP file " + Quote(path.string()) + ": " + e.what());
+  }
 }
 
 // ---- Writing ----------------------------------------------------------------------------------
@@ -778,21 +806,18 @@ Result<void> WriteStepLocked(const StepDocumentSpec& spec, const fs::path& path)
 
 bool StepImportAvailable() { return true; }
 
+Result<StepAssembly> ImportStepInProcess(const fs::path& path,
+                                         const StepTessellation& tessellation) {
+  if (auto ok = CheckBeforeReading(path, tessellation); !ok) return std::unexpected(ok.error());
+  return ReadStepGuarded(path, tessellation, Locking::kLock);
+}
+
 Result<StepAssembly> ImportStep(const fs::path& path, const StepTessellation& tessellation) {
-  if (auto ok = CheckTessellation(tessellation, path.string()); !ok) {
-    return std::unexpected(ok.error());
-  }
-  if (auto ok = detail::CheckStepFile(path); !ok) return std::unexpected(ok.error());
-  try {
-    return ReadStep(path, tessellation);
-  } catch (const Standard_Failure& e) {
-    return Fail(ErrorCode::kInvalidInput, "cannot read STEP file " + Quote(path.string()) +
-                                              ": OpenCASCADE failed (" + e.DynamicType()->Name() +
-                                              ": " + e.GetMessageString() + ")");
-  } catch (const std::exception& e) {
-    return Fail(ErrorCode::kInvalidInput,
-                "cannot read STEP file " + Quote(path.string()) + ": " + e.what());
-  }
+  // The checks here, so that their errors need no child process.
+  if (auto ok = CheckBeforeReading(path, tessellation); !ok) return std::unexpected(ok.error());
+  return detail::ImportInChild(
+      path.string(), [&] { return ReadStepGuarded(path, tessellation, Locking::kInheritedLock); },
+      OcctMutex());
 }
 
 Result<void> WriteStep(const StepDocumentSpec& spec, const fs::path& path) {

@@ -24,6 +24,11 @@ Result<StepAssembly> ImportStep(const std::filesystem::path& path, const StepTes
               Unavailable("cannot read STEP file '" + path.string() + "'"));
 }
 
+Result<StepAssembly> ImportStepInProcess(const std::filesystem::path& path,
+                                         const StepTessellation& tessellation) {
+  return ImportStep(path, tessellation);
+}
+
 Result<void> WriteStep(const StepDocumentSpec&, const std::filesystem::path& path) {
   return Fail(ErrorCode::kInvalidInput,
               Unavailable("cannot write STEP file '" + path.string() + "'"));

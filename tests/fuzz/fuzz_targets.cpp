@@ -110,10 +110,12 @@ int FuzzMesh(const uint8_t* data, size_t size, const std::string& extension) {
   return 0;
 }
 
-int FuzzStep(const uint8_t* data, size_t size) {
+int FuzzStep(const uint8_t* data, size_t size, StepProcess process) {
   const fs::path file = WriteScratch("model.step", data, size);
   try {
-    auto assembly = ImportStep(file, {.linear_deflection_m = 1e-3, .angular_deflection_rad = 0.5});
+    const StepTessellation coarse{.linear_deflection_m = 1e-3, .angular_deflection_rad = 0.5};
+    auto assembly = process == StepProcess::kChild ? ImportStep(file, coarse)
+                                                   : ImportStepInProcess(file, coarse);
     if (!assembly) {
       if (assembly.error().message.empty()) Broken("step", "failure without a message");
       return 0;

@@ -22,11 +22,17 @@ int FuzzProjectJson(const uint8_t* data, size_t size);
 /// properties as validation does.
 int FuzzMesh(const uint8_t* data, size_t size, const std::string& extension);
 
-/// STEP bytes written to a .step file and read by ImportStep (coarse tessellation, so that huge
+/// Where FuzzStep runs OpenCASCADE.
+enum class StepProcess {
+  kThisProcess,  ///< ImportStepInProcess: libFuzzer sees OpenCASCADE's crashes and coverage.
+  kChild,        ///< ImportStep, as `wrap` does: a crash in OpenCASCADE must become an error.
+};
+
+/// STEP bytes written to a .step file and imported (coarse tessellation, so that huge
 /// coordinates cannot ask for billions of triangles); an accepted file has instances whose
 /// solids exist, closed outward solids with indices in range and finite placements, and every
 /// solid can be picked by name. Without OpenCASCADE the import must fail with a message.
-int FuzzStep(const uint8_t* data, size_t size);
+int FuzzStep(const uint8_t* data, size_t size, StepProcess process);
 
 /// URDF bytes written to a file and read by ImportUrdf; an accepted chain has one more link than
 /// joints and ordered joint limits.

@@ -101,6 +101,28 @@ TEST_F(StepImportGui, BadFileFailsNamingIt) {
   EXPECT_NE(parts.error().message.find("truncated"), std::string::npos) << parts.error().message;
 }
 
+// A file that crashes OpenCASCADE 7.6 (found by fuzz_step): the import fails naming it, the
+// document and this process live on.
+TEST_F(StepImportGui, FileThatCrashesOpenCascadeFailsAndTheDocumentLivesOn) {
+  Document doc(Project{}, dir_ / "project.json");
+  auto first = PrepareStepImport(doc.project(), doc.ResolvePath(), dir_ / "cad" / "block.stp");
+  ASSERT_TRUE(first.has_value()) << first.error().message;
+  ASSERT_TRUE(doc.Execute(AddParts(*first)));
+  const Project before = doc.project();
+  const fs::path crash = fs::path(WRAP_SOURCE_DIR) /
+                         "tests/fuzz/regressions/step_crashes_occt/face_bound_of_wrong_type.step";
+  auto parts = PrepareStepImport(doc.project(), doc.ResolvePath(), crash);
+  ASSERT_FALSE(parts.has_value());
+  EXPECT_NE(parts.error().message.find(crash.string()), std::string::npos)
+      << parts.error().message;
+  EXPECT_NE(parts.error().message.find("OpenCASCADE crashed on it"), std::string::npos)
+      << parts.error().message;
+  EXPECT_EQ(doc.project(), before);
+  // The importer still works afterwards.
+  auto again = PrepareStepImport(doc.project(), doc.ResolvePath(), dir_ / "cad" / "stool.step");
+  EXPECT_TRUE(again.has_value());
+}
+
 }  // namespace
 }  // namespace wrap::gui
 #endif  // WRAP_TEST_WITH_OCCT
