@@ -7,8 +7,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
 
 #include "generator/step_designs.h"
+#include "geometry/detail/step_isolation.h"
 #include "geometry/step_cache.h"
 #include "geometry/step_import.h"
 
@@ -82,10 +84,14 @@ void Report(benchmark::State& state, const StepAssembly& a) {
       parts, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
-void Import(benchmark::State& state, const fs::path& file, const StepTessellation& t = {}) {
+/// ImportStep (OpenCASCADE in a child process, as `wrap` reads STEP) or ImportStepInProcess.
+enum class Where { kChild, kThisProcess };
+
+void Import(benchmark::State& state, const fs::path& file, const StepTessellation& t = {},
+            Where where = Where::kChild) {
   StepAssembly last;
   for (auto _ : state) {
-    auto a = ImportStep(file, t);
+    auto a = where == Where::kChild ? ImportStep(file, t) : ImportStepInProcess(file, t);
     if (!a) {
       state.SkipWithError(a.error().message.c_str());
       return;
@@ -99,14 +105,40 @@ void Import(benchmark::State& state, const fs::path& file, const StepTessellatio
 void BM_StepImportStool(benchmark::State& state) {
   Import(state, Written(partgen::StepStoolSpec(), "stool.step"));
 }
-BENCHMARK(BM_StepImportStool)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StepImportStool)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The same in this process: the difference is the child process's cost.
+void BM_StepImportStoolInProcess(benchmark::State& state) {
+  Import(state, Written(partgen::StepStoolSpec(), "stool.step"), {}, Where::kThisProcess);
+}
+BENCHMARK(BM_StepImportStoolInProcess)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The child process alone: fork, a one-solid answer through the pipe, wait.
+void BM_StepChildProcessOverhead(benchmark::State& state) {
+  std::mutex held;
+  StepAssembly tiny;
+  tiny.solids.push_back({.name = "s", .product = "s", .entity = "#1", .mesh = {}});
+  tiny.solids[0].mesh.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  tiny.solids[0].mesh.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  tiny.instances.push_back({.name = "s", .solid = 0});
+  for (auto _ : state) {
+    auto a = detail::ImportInChild(
+        "tiny.step", [&] { return Result<StepAssembly>(tiny); }, held);
+    if (!a) {
+      state.SkipWithError(a.error().message.c_str());
+      return;
+    }
+    benchmark::DoNotOptimize(a);
+  }
+}
+BENCHMARK(BM_StepChildProcessOverhead)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The stool with a finer tessellation (0.01 mm, 10 degrees).
 void BM_StepImportStoolFine(benchmark::State& state) {
   Import(state, Written(partgen::StepStoolSpec(), "stool.step"),
          {.linear_deflection_m = 1e-5, .angular_deflection_rad = 0.1745});
 }
-BENCHMARK(BM_StepImportStoolFine)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StepImportStoolFine)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Parts bins: products x copies.
 void BM_StepImportBin(benchmark::State& state) {
@@ -119,7 +151,8 @@ BENCHMARK(BM_StepImportBin)
     ->Args({10, 1})
     ->Args({10, 5})
     ->Args({40, 1})
-    ->Unit(benchmark::kMillisecond);
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // A reopen: the 40-product bin read back from the disk cache (no OpenCASCADE at all).
 void BM_StepReopenFromCache(benchmark::State& state) {
