@@ -93,6 +93,39 @@ TEST(Script, RefusalsFailTheLineAndExpectRefusedChecksThem) {
   EXPECT_FALSE(RunScript(app, "set part.seat.mass_kg heavy\n"));
 }
 
+// Planner options and check arguments are numbers or refused; junk never becomes 0.
+TEST(Script, OptionsAndCheckArgumentsRefuseWhatIsNotANumber) {
+  AppState app;
+  OpenStool(app);
+  ASSERT_TRUE(RunScript(app,
+                        "option seed 7\noption grasps 32\noption time_limit_s 12.5\n"
+                        "option budget 2\noption task_only 1\n"));
+  EXPECT_EQ(app.request.seed, 7u);
+  EXPECT_EQ(app.request.grasps, 32);
+  EXPECT_DOUBLE_EQ(app.request.time_limit_s, 12.5);
+  EXPECT_DOUBLE_EQ(app.request.budget, 2.0);
+  EXPECT_TRUE(app.request.task_only);
+  const PlannerRequest before = app.request;
+  for (const char* bad :
+       {"option seed abc\n", "option seed -1\n", "option seed 1.5\n", "option grasps many\n",
+        "option time_limit_s 0\n", "option budget 2x\n", "option task_only yes\n"}) {
+    auto r = RunScript(app, bad);
+    ASSERT_FALSE(r) << bad;
+    EXPECT_NE(r.error().message.find("line 1"), std::string::npos) << r.error().message;
+  }
+  auto junk = RunScript(app, "option seed abc\n");
+  ASSERT_FALSE(junk);
+  EXPECT_NE(junk.error().message.find("'abc' is not a number"), std::string::npos)
+      << junk.error().message;
+  EXPECT_EQ(app.request.seed, before.seed);
+  EXPECT_EQ(app.request.grasps, before.grasps);
+  EXPECT_DOUBLE_EQ(app.request.time_limit_s, before.time_limit_s);
+  auto direction = RunScript(app, "expect-free-direction seat+leg1 0 0 up\n");
+  ASSERT_FALSE(direction);
+  EXPECT_NE(direction.error().message.find("'up' is not a number"), std::string::npos)
+      << direction.error().message;
+}
+
 TEST(Script, SaveAndScreenshotPathsResolveAgainstTheScriptFolder) {
   const auto dir = ScratchDir("script_save");
   AppState app;

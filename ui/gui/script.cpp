@@ -84,6 +84,25 @@ Result<ScriptEffect> ViewVerb(AppState& app, const ScriptLine& line, const fs::p
   return ScriptEffect{};
 }
 
+/// The numeric options of `option NAME VALUE`, refused (naming the word) unless a positive number
+/// (seed, grasps: whole numbers from 0; grasps 0: the project's).
+Result<ScriptEffect> NumericOption(PlannerRequest& q, const ScriptLine& line) {
+  const std::string& name = line.words[1];
+  auto x = Number(line, line.words[2]);
+  if (!x) return std::unexpected(x.error());
+  const bool whole = *x == std::floor(*x) && *x < 1e15;
+  if (name == "seed" && whole && *x >= 0) {
+    q.seed = static_cast<uint64_t>(*x);
+  } else if (name == "grasps" && whole && *x >= 0) {
+    q.grasps = static_cast<int>(std::min(*x, 1e6));
+  } else if ((name == "time_limit_s" || name == "budget") && *x > 0) {
+    (name == "budget" ? q.budget : q.time_limit_s) = *x;
+  } else {
+    return LineError(line, "option " + name + ": '" + line.words[2] + "' is out of range");
+  }
+  return ScriptEffect{};
+}
+
 /// `option NAME VALUE`: the Planner panel's options for the next run.
 Result<ScriptEffect> OptionVerb(AppState& app, const ScriptLine& line, const fs::path&) {
   const std::vector<std::string>& w = line.words;
@@ -93,18 +112,12 @@ Result<ScriptEffect> OptionVerb(AppState& app, const ScriptLine& line, const fs:
     q.planner = v;
   else if (w[1] == "wrench")
     q.wrench = v;
-  else if (w[1] == "time_limit_s")
-    q.time_limit_s = std::atof(v.c_str());
-  else if (w[1] == "seed")
-    q.seed = std::strtoull(v.c_str(), nullptr, 10);
-  else if (w[1] == "budget")
-    q.budget = std::atof(v.c_str());
-  else if (w[1] == "task_only")
+  else if (w[1] == "task_only" && (v == "0" || v == "1" || v == "true" || v == "false"))
     q.task_only = v == "1" || v == "true";
-  else if (w[1] == "grasps")
-    q.grasps = std::atoi(v.c_str());
+  else if (w[1] == "time_limit_s" || w[1] == "budget" || w[1] == "seed" || w[1] == "grasps")
+    return NumericOption(q, line);
   else
-    return LineError(line, "unknown planner option '" + w[1] + "'");
+    return LineError(line, "unknown planner option '" + w[1] + "' or value '" + v + "'");
   return ScriptEffect{};
 }
 

@@ -57,8 +57,9 @@ Result<Check> GeometryCheck(const ScriptLine& line) {
     });
   }
   if (cmd == "expect-free-direction") {
-    Vec3 d;
-    for (int i = 0; i < 3; ++i) d[i] = std::strtod(w[2 + i].c_str(), nullptr);
+    auto direction = script_detail::Vector(line, 2);
+    if (!direction) return std::unexpected(direction.error());
+    const Vec3 d = *direction;
     if (!(d.norm() > 1e-9)) return LineError(line, "expect-free-direction STEP X Y Z: not zero");
     const std::string step = w[1];
     const Vec3 want = d.normalized();
