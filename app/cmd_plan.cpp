@@ -164,9 +164,9 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   out << "Preprocessing (t_grasp) " << Fmt("%.2f", st.t_grasp_s) << " s\n";
   if (st.solved) {
     if (args.optimize) {
-      out << "Improved (" << st.objective << "): cost " << st.first_cost << " -> " << st.cost
-          << " in " << Fmt("%.2f", st.t_opt_s) << " s (" << st.cost_history.size() - 1
-          << " improvements)\n";
+      out << "Improved: cost " << st.first_cost << " -> " << st.cost << " in "
+          << Fmt("%.2f", st.t_opt_s) << " s (" << st.cost_history.size() - 1
+          << " improvements, objective " << st.objective << ")\n";
     }
     out << "Solved: cost " << st.cost << ", estimated makespan " << Fmt("%.1f", st.makespan_est_s)
         << " s, time to first plan " << Fmt("%.2f", st.t_init_s) << " s (t_fwd "
