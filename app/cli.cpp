@@ -149,6 +149,9 @@ struct PlanCli {
     cmd->add_flag("--optimize", args.optimize,
                   "After the first plan, improve it (large neighbourhood search) until the time "
                   "limit or until no window of milestones gives a cheaper plan");
+    cmd->add_option("--objective", args.objective,
+                    "What --optimize minimises: actions (default: the number of actions) or "
+                    "makespan (the task plan's makespan estimate, a few more actions allowed)");
     cmd->add_option("--memory-limit", args.memory_limit_mb,
                     "Memory the search may hold, in MiB (default 4096); beyond it the run stops "
                     "with \"out of memory\"")

@@ -93,6 +93,7 @@ struct PlanArgs {
   double force_scale = 1.0;           ///< --force-scale lambda.
   std::string planner = "wrap";       ///< --planner variant.
   bool optimize = false;              ///< --optimize: improve the plan until the time limit.
+  std::string objective = "actions";  ///< --objective actions|makespan: what --optimize lowers.
   long long memory_limit_mb = 4096;   ///< --memory-limit [MiB].
   int grasps = 0;                     ///< --grasps; 0: the project's planner.grasps.
   bool validate = false;              ///< --validate with the independent validator.

@@ -92,6 +92,12 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   }
   options.planner = *variant;
   options.optimize = args.optimize;
+  const Result<PlanObjective> objective = ParsePlanObjective(args.objective);
+  if (!objective) {
+    err << "--objective: " << objective.error().message << "\n";
+    return ExitCodeFor(objective.error().code);
+  }
+  options.objective = *objective;
   options.memory_limit_mb = args.memory_limit_mb;
   if (args.wrench == "full") {
     options.wrench_mode = MatingWrenchMode::kFull;
@@ -159,12 +165,14 @@ int PlanCommand(const PlanArgs& args, std::ostream& out, std::ostream& err) {
   if (st.solved) {
     if (args.optimize) {
       out << "Improved: cost " << st.first_cost << " -> " << st.cost << " in "
-          << Fmt("%.2f", st.t_opt_s) << " s (" << st.cost_history.size() - 1 << " improvements)\n";
+          << Fmt("%.2f", st.t_opt_s) << " s (" << st.cost_history.size() - 1
+          << " improvements, objective " << st.objective << ")\n";
     }
-    out << "Solved: cost " << st.cost << ", time to first plan " << Fmt("%.2f", st.t_init_s)
-        << " s (t_fwd " << Fmt("%.2f", st.t_fwd_s) << ", t_ik " << Fmt("%.2f", st.t_ik_s)
-        << ", t_lp " << Fmt("%.2f", st.t_lp_s) << "; " << st.expansions << " nodes, "
-        << st.validations << " edges validated, " << st.validation_failures << " failed)\n";
+    out << "Solved: cost " << st.cost << ", estimated makespan " << Fmt("%.1f", st.makespan_est_s)
+        << " s, time to first plan " << Fmt("%.2f", st.t_init_s) << " s (t_fwd "
+        << Fmt("%.2f", st.t_fwd_s) << ", t_ik " << Fmt("%.2f", st.t_ik_s) << ", t_lp "
+        << Fmt("%.2f", st.t_lp_s) << "; " << st.expansions << " nodes, " << st.validations
+        << " edges validated, " << st.validation_failures << " failed)\n";
     for (size_t i = 0; i < plan.actions.size(); ++i) {
       out << "  " << (i + 1) << ". " << DescribeAction(plan, plan.actions[i]) << "\n";
     }

@@ -3,7 +3,9 @@
 // by the KeyframeSolver; what holds is committed, a failed edge is suspended until the next
 // effort level (or for good), and a committed state from which nothing is found is abandoned.
 #include <algorithm>
+#include <cmath>
 #include <queue>
+#include <span>
 #include <tuple>
 #include <unordered_set>
 
@@ -34,7 +36,8 @@ std::size_t TaskSearch::MemoryBytes(std::size_t open, std::size_t closed) const 
   // A node: the struct, its state's three vectors (heap blocks with their headers).
   const std::size_t state = static_cast<std::size_t>(world_.num_nodes) * 2 +
                             static_cast<std::size_t>(n_robots_) * 6 + 3 * 32;
-  std::size_t bytes = nodes_.capacity() * (sizeof(Node) + state);
+  const std::size_t clock = static_cast<std::size_t>(world_.num_nodes + n_robots_) * 4 + 16;
+  std::size_t bytes = nodes_.capacity() * (sizeof(Node) + state + clock);
   bytes += open * 48 + closed * 48;  // the queue's entries, the hash map's
   // Caches that live across searches: witnesses hold keyframes (joint vectors, poses).
   bytes += witnesses_.size() * 2048 + cheap_.size() * 96 + failed_level_.size() * 48;
@@ -42,21 +45,31 @@ std::size_t TaskSearch::MemoryBytes(std::size_t open, std::size_t closed) const 
 }
 
 TaskSearch::SearchStatus TaskSearch::BestFirst(
-    const SymState& s0, const Milestone& m, const Resolution& res, int effort,
+    const SymState& s0, const TaskClock& t0, const Milestone& m, const Resolution& res, int effort,
     const std::set<std::uint64_t>& excluded,
     const std::unordered_map<std::uint64_t, bool>& dead_ends,
     const std::unordered_set<std::uint64_t>& forbidden, long long node_budget, int g0, int max_cost,
     std::vector<int>& path) {
   nodes_.clear();
   FlatMap<int> best_g;
-  using Entry = std::tuple<int, int, long long, int>;  // f, -g, sequence, node
+  // Ordered by f, then deeper first, then the order of insertion. The makespan objective puts
+  // the makespan estimate before the depth and its sum of action ends after it: among
+  // candidates as long, the one whose work runs more at once comes first.
+  using Entry = std::tuple<int, long long, long long, long long, long long, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
   long long sequence = 0;
+  const bool by_makespan = options_.objective == PlanObjective::kMakespan;
+  auto entry = [&](int f, int g, const TaskClock& clock, int node) {
+    if (!by_makespan) return Entry{f, -g, 0, 0, sequence++, node};
+    const long long makespan_ms = std::llround(1000.0 * clock.makespan_s());
+    const long long sum_ms = std::llround(1000.0 * clock.completion_sum_s());
+    return Entry{f, makespan_ms, -g, sum_ms, sequence++, node};
+  };
   const int h0 = Heuristic(s0, m);
   if (g0 + h0 > max_cost) return SearchStatus::kExhausted;
-  nodes_.push_back({s0, 0, -1, {}, s0.Hash()});
+  nodes_.push_back({s0, 0, -1, {}, s0.Hash(), t0});
   best_g[nodes_.back().hash] = 0;
-  open.push({weight_ * h0, 0, sequence++, 0});
+  open.push(entry(weight_ * h0, 0, t0, 0));
   const std::size_t memory_limit = static_cast<std::size_t>(options_.memory_limit_mb) << 20;
   SuccessorList successors;
   while (!open.empty()) {
@@ -72,7 +85,7 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(
         if (rss > rss0_ && rss - rss0_ > memory_limit) return SearchStatus::kOutOfMemory;
       }
     }
-    const auto [f, neg_g, seq, index] = open.top();
+    const int index = std::get<5>(open.top());
     open.pop();
     const int g = nodes_[index].g;
     const std::uint64_t h = nodes_[index].hash;
@@ -102,8 +115,10 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(
       const int hv = Heuristic(s2, m);
       if (g0 + g2 + hv > max_cost) continue;  // plan improvement: cannot beat the bound
       const int child = static_cast<int>(nodes_.size());
-      nodes_.push_back({std::move(s2), g2, index, a, h2});
-      open.push({g2 + weight_ * hv, -g2, sequence++, child});
+      TaskClock clock = nodes_[index].clock;
+      Advance(s, a, clock);
+      open.push(entry(g2 + weight_ * hv, g2, clock, child));
+      nodes_.push_back({std::move(s2), g2, index, a, h2, std::move(clock)});
     }
   }
   return SearchStatus::kExhausted;
@@ -111,6 +126,7 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(
 
 TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const Resolution& res,
                                             const SymState& s0, const ContState& c0,
+                                            const TaskClock& t0,
                                             const std::set<std::uint64_t>& excluded,
                                             const FillLimits& limits, MilestoneResult& result) {
   // The committed prefix: validated states from s0 on. The search starts from its last state;
@@ -141,7 +157,7 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
   int target_failures = 0;
   for (int effort = 0; effort <= options_.max_effort; ++effort) {
     bool suspended_below = false;  // an edge that failed at this effort could be retried
-    std::vector<Committed> prefix{{s0, c0, 0}};
+    std::vector<Committed> prefix{{s0, c0, 0, t0}};
     std::vector<PlanAction> actions;
     std::unordered_map<std::uint64_t, bool> dead_ends;  // edges into abandoned states
     int root_failures = 0;
@@ -151,9 +167,9 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
       on_prefix.clear();
       for (const Committed& p : prefix) on_prefix.insert(p.s.Hash());
       const int g0 = static_cast<int>(prefix.size()) - 1;
-      SearchStatus status =
-          BestFirst(prefix.back().s, m, res, effort, excluded, dead_ends, on_prefix,
-                    prefix.size() == 1 ? root_budget : local_budget, g0, max_actions, path);
+      SearchStatus status = BestFirst(
+          prefix.back().s, prefix.back().clock, m, res, effort, excluded, dead_ends, on_prefix,
+          prefix.size() == 1 ? root_budget : local_budget, g0, max_actions, path);
       if (ctx_.Logs("task")) {
         ctx_.Log("task",
                  StrFormat("milestone %d effort %d depth %d: status %d, %zu nodes, path %zu", index,
@@ -192,6 +208,7 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
           result.after.push_back({prefix[i].s, prefix[i].c});
         result.end = prefix.back().s;
         result.end_c = prefix.back().c;
+        result.end_clock = prefix.back().clock;
         return SearchStatus::kFound;
       }
     }
@@ -240,7 +257,7 @@ TaskSearch::CandidateStatus TaskSearch::CommitCandidate(
     }
     actions.push_back(
         MakeAction(s, a, w->second, m.flat && !window_.empty() ? index + WindowDone(s) : index));
-    prefix.push_back({next, w->second.next, edge});
+    prefix.push_back({next, w->second.next, edge, nodes_[node_index].clock});
   }
   return CandidateStatus::kValid;
 }
@@ -277,6 +294,23 @@ void TaskSearch::TallyEdgeFailure(const SymState& s, const ContState& c, const T
   if (tally_.count[static_cast<int>(outcome.gate)] == 1) {
     tally_.scene[static_cast<int>(outcome.gate)] = std::move(outcome.scene);
   }
+}
+
+void TaskSearch::Advance(const SymState& s, const TaskAction& a, TaskClock& clock) const {
+  if (a.type != ActionType::kAssemble) {
+    const int robots[2] = {a.r1, a.r2};
+    const int object = a.obj;
+    clock.Advance(a.type, std::span<const int>(robots, a.type == ActionType::kHandover ? 2 : 1),
+                  std::span<const int>(&object, 1));
+    return;
+  }
+  const StepInterface& st = world_.interface(a.obj);
+  const int objects[3] = {st.moved, st.base, a.obj};
+  std::vector<int> robots;
+  for (int r = 0; r < n_robots_; ++r) {
+    if (s.held[r] == st.moved || s.held[r] == st.base) robots.push_back(r);
+  }
+  clock.Advance(a.type, robots, objects);
 }
 
 PlanAction TaskSearch::MakeAction(const SymState& s, const TaskAction& a, const EdgeOutcome& e,

@@ -200,6 +200,11 @@ struct PlanStats {
   /// Cost over time (--optimize): (seconds since planning started, cost) at the first plan
   /// and at every improvement.
   std::vector<std::pair<double, int>> cost_history;
+  /// What --optimize minimised: "actions" (the number of actions) or "makespan".
+  std::string objective;
+  /// The task plan's makespan estimate (makespan_estimate.h): actions of estimated durations by
+  /// type, each as early as its robots and objects allow [s]; 0 when not solved.
+  double makespan_est_s = 0.0;
   std::string failure;  ///< Empty when solved, else why not, in words.
   /// The same as data when not solved (where it failed and the checks that failed there, with
   /// the cell at each); absent when solved or when the planner could not say. Not saved.

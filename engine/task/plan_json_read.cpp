@@ -338,6 +338,8 @@ PlanStats ReadStats(const json& root, const std::string& at) {
              "cost",
              "t_init_s",
              "planner",
+             "objective",
+             "makespan_est_s",
              "seed",
              "t_grasp_s",
              "t_bwd_s",
@@ -401,6 +403,8 @@ PlanStats ReadStats(const json& root, const std::string& at) {
   time("t_lp_s", s.t_lp_s);
   time("t_fwd_s", s.t_fwd_s);
   time("t_ik_s", s.t_ik_s);
+  if (Find(j, "objective")) s.objective = String(j, at, "objective");
+  time("makespan_est_s", s.makespan_est_s);
   if (Find(j, "wrench_mode")) s.wrench_mode = String(j, at, "wrench_mode");
   if (Find(j, "force_scale")) s.force_scale = Number(j, at, "force_scale");
   small("grasps", s.grasps);

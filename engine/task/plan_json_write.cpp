@@ -54,6 +54,8 @@ ojson StatsJson(const PlanStats& s) {
                {"cost", s.cost},
                {"t_init_s", s.t_init_s},
                {"planner", s.planner},
+               {"objective", s.objective},
+               {"makespan_est_s", s.makespan_est_s},
                {"seed", s.seed},
                {"t_grasp_s", s.t_grasp_s},
                {"t_bwd_s", s.t_bwd_s},

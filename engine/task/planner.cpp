@@ -55,10 +55,34 @@ constexpr int kWindowFailures = 60;
 // ... and search nodes per milestone of the window.
 constexpr long long kWindowNodes = 40000;
 
+// --objective makespan: actions a plan may have beyond the first plan's when its makespan
+// estimate is shorter (a handover that lets two robots work at once may pay for itself).
+constexpr int kMakespanExtraActions = 2;
+
 int CostOf(const std::vector<MilestoneResult>& results, int from, int to) {
   int cost = 0;
   for (int j = from; j < to; ++j) cost += static_cast<int>(results[j].actions.size());
   return cost;
+}
+
+// The makespan estimate's clock after milestones [0, to) of `results`.
+TaskClock ClockOf(const std::vector<MilestoneResult>& results, int to, const TaskClock& start) {
+  TaskClock clock = start;
+  for (int j = 0; j < to; ++j) {
+    for (const PlanAction& a : results[j].actions) clock.Advance(a);
+  }
+  return clock;
+}
+
+// Whether a plan of `cost` actions and makespan estimate `makespan_s` replaces the incumbent's
+// (`best_cost`, `best_makespan_s`) under `objective`; `max_cost`: the most actions allowed.
+bool Better(PlanObjective objective, int cost, double makespan_s, int best_cost,
+            double best_makespan_s, int max_cost) {
+  if (objective == PlanObjective::kActions) return cost < best_cost;
+  constexpr double kSame = 1e-3;  // [s]
+  if (cost > max_cost) return false;
+  if (makespan_s < best_makespan_s - kSame) return true;
+  return makespan_s <= best_makespan_s + kSame && cost < best_cost;
 }
 
 // Plan improvement (paper §IV-D, "anytime"): a large neighbourhood search over the milestones of
@@ -70,31 +94,41 @@ int CostOf(const std::vector<MilestoneResult>& results, int from, int to) {
 // horizon; the search stops early at the time limit or on cancellation. Returns false when it
 // was stopped.
 bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& s0,
-             const ContState& c0, std::vector<MilestoneResult>& incumbent, RunContext& ctx,
+             const ContState& c0, const TaskClock& t0, PlanObjective objective,
+             std::vector<MilestoneResult>& incumbent, RunContext& ctx,
              const Clock::time_point start, std::vector<std::pair<double, int>>& history) {
   const int K = static_cast<int>(order.size());
   int cost = CostOf(incumbent, 0, K);
+  double makespan_s = ClockOf(incumbent, K, t0).makespan_s();
+  // The most actions a plan may have: fewer than the incumbent's (actions), or the first plan's
+  // and a few more (makespan).
+  const bool by_makespan = objective == PlanObjective::kMakespan;
+  const int max_cost = by_makespan ? cost + kMakespanExtraActions : cost;
   const bool debug = ctx.Logs("task");
   for (int n = 1; n <= K; ++n) {
     for (int i = 0; i + n <= K; ++i) {
       if (ctx.ShouldStop()) return false;
       const int window_cost = CostOf(incumbent, i, i + n);
-      const int budget = cost - CostOf(incumbent, 0, i) - 1;  // the rest, strictly cheaper
+      // The rest: strictly cheaper (actions), or within the bound (makespan).
+      const int budget = (by_makespan ? max_cost : cost - 1) - CostOf(incumbent, 0, i);
       std::vector<MilestoneResult> candidate(incumbent.begin(), incumbent.begin() + i);
       SymState s = i == 0 ? s0 : incumbent[i - 1].end;
       ContState c = i == 0 ? c0 : incumbent[i - 1].end_c;
-      // The window: one weight-one search over its n milestones, no worse than before.
+      TaskClock t = i == 0 ? t0 : incumbent[i - 1].end_clock;
+      // The window: one weight-one search over its n milestones, no longer than before
+      // (actions), or within the bound (makespan).
       FillLimits window;
       window.weight = 1;
       window.max_failures = kWindowFailures;
       window.max_nodes = kWindowNodes;
-      window.max_cost = std::min(window_cost, budget - (K - i - n));
+      window.max_cost = std::min(by_makespan ? window_cost + kMakespanExtraActions : window_cost,
+                                 budget - (K - i - n));
       if (window.max_cost < n) continue;
       const int next = i + n < K ? order[i + n] : -1;
       MilestoneResult w =
-          n == 1 ? search.Fill(i, order[i], next, s, c, {}, window)
+          n == 1 ? search.Fill(i, order[i], next, s, c, t, {}, window)
                  : search.FillWindow(i, std::vector<int>(order.begin() + i, order.begin() + i + n),
-                                     next, s, c, window);
+                                     next, s, c, t, window);
       if (debug) {
         ctx.Log("task",
                 StrFormat("improve: window %d+%d (cost %d, bound %d): %s %zu at %.2f s", i, n,
@@ -109,19 +143,22 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
       // The window's actions fill candidate milestones i .. i+n-1 (by their milestone index).
       // (A milestone ends with its last action; the window's last one with the window.)
       for (int j = i; j < i + n; ++j) candidate.emplace_back().ok = true;
-      for (size_t t = 0; t < w.actions.size(); ++t) {
-        const int j = std::clamp(w.actions[t].milestone, i, i + n - 1);
-        w.actions[t].milestone = j;
-        candidate[j].actions.push_back(std::move(w.actions[t]));
-        candidate[j].end = w.after[t].first;
-        candidate[j].end_c = w.after[t].second;
+      for (size_t x = 0; x < w.actions.size(); ++x) {
+        const int j = std::clamp(w.actions[x].milestone, i, i + n - 1);
+        w.actions[x].milestone = j;
+        t.Advance(w.actions[x]);
+        candidate[j].actions.push_back(std::move(w.actions[x]));
+        candidate[j].end = w.after[x].first;
+        candidate[j].end_c = w.after[x].second;
+        candidate[j].end_clock = t;
       }
       bool ok = true;
       for (int j = i + n; j < K && ok; ++j) {
         if (s == incumbent[j - 1].end &&
             c.Fingerprint(s) == incumbent[j - 1].end_c.Fingerprint(s)) {
-          // The window ends where the incumbent's did: the rest holds as it is.
-          for (int t = j; t < K; ++t) candidate.push_back(incumbent[t]);
+          // The window ends where the incumbent's did: the rest holds as it is (its clocks
+          // are made again below).
+          for (int x = j; x < K; ++x) candidate.push_back(incumbent[x]);
           running += CostOf(incumbent, j, K);
           break;
         }
@@ -134,7 +171,7 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
           break;
         }
         MilestoneResult r =
-            search.Fill(j, order[j], j + 1 < K ? order[j + 1] : -1, s, c, {}, limits);
+            search.Fill(j, order[j], j + 1 < K ? order[j + 1] : -1, s, c, t, {}, limits);
         if (r.stopped || r.out_of_memory) return false;
         if (!r.ok) {
           ok = false;
@@ -143,15 +180,27 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
         running += static_cast<int>(r.actions.size());
         s = r.end;
         c = r.end_c;
+        t = r.end_clock;
         candidate.push_back(std::move(r));
       }
-      if (ok && static_cast<int>(candidate.size()) == K && CostOf(candidate, 0, K) < cost) {
+      if (!ok || static_cast<int>(candidate.size()) != K) continue;
+      // The clocks of the milestones kept from the incumbent follow the window's.
+      TaskClock clock = t0;
+      for (MilestoneResult& r : candidate) {
+        for (const PlanAction& a : r.actions) clock.Advance(a);
+        r.end_clock = clock;
+      }
+      const int candidate_cost = CostOf(candidate, 0, K);
+      if (Better(objective, candidate_cost, clock.makespan_s(), cost, makespan_s, max_cost)) {
         incumbent = std::move(candidate);
-        cost = CostOf(incumbent, 0, K);
-        const double t = std::chrono::duration<double>(Clock::now() - start).count();
-        history.push_back({t, cost});
+        cost = candidate_cost;
+        makespan_s = clock.makespan_s();
+        const double at = std::chrono::duration<double>(Clock::now() - start).count();
+        history.push_back({at, cost});
         if (debug) {
-          ctx.Log("task", StrFormat("improve: window %d+%d: cost %d at %.2f s", i, n, cost, t));
+          ctx.Log("task", StrFormat("improve: window %d+%d: cost %d, makespan estimate %.1f s at "
+                                    "%.2f s",
+                                    i, n, cost, makespan_s, at));
         }
       }
     }
@@ -277,9 +326,11 @@ MilestoneRun FillMilestones(TaskSearch& search, const TaskWorld& world,
     ctx.Progress("task", static_cast<double>(k) / std::max(1, K), words);
     const SymState& s = k == 0 ? s0 : results[k - 1].end;
     const ContState& c = k == 0 ? c0 : results[k - 1].end_c;
+    const TaskClock t = k == 0 ? TaskClock(static_cast<int>(world.robots.size()), world.num_nodes)
+                               : results[k - 1].end_clock;
     MilestoneResult r =
         flat ? search.FillFlat(s0, c0)
-             : search.Fill(k, order[k], k + 1 < K ? order[k + 1] : -1, s, c, excluded[k]);
+             : search.Fill(k, order[k], k + 1 < K ? order[k + 1] : -1, s, c, t, excluded[k]);
     if (r.ok) {
       if (flat) {
         results[0] = std::move(r);
@@ -321,6 +372,7 @@ void CountSearch(const Project& project, const Preprocessed& pre, const TaskPlan
                  const TaskSearch& search, const TaskCounters& counters, RunContext& ctx,
                  PlanStats& st) {
   st.planner = std::string(ToString(options.planner));
+  st.objective = std::string(ToString(options.objective));
   st.seed = project.planner.seed;
   st.wrench_mode = ModeName(options.wrench_mode);
   st.force_scale = options.force_scale;
@@ -384,6 +436,24 @@ std::string_view ToString(PlannerVariant variant) {
   return "?";
 }
 
+std::string_view ToString(PlanObjective objective) {
+  switch (objective) {
+    case PlanObjective::kActions:
+      return "actions";
+    case PlanObjective::kMakespan:
+      return "makespan";
+  }
+  return "?";
+}
+
+Result<PlanObjective> ParsePlanObjective(std::string_view name) {
+  for (PlanObjective o : {PlanObjective::kActions, PlanObjective::kMakespan}) {
+    if (ToString(o) == name) return o;
+  }
+  return Fail(ErrorCode::kInvalidInput,
+              "planner: unknown objective '" + std::string(name) + "' (known: actions, makespan)");
+}
+
 Result<PlannerVariant> ParsePlannerVariant(std::string_view name) {
   for (PlannerVariant v :
        {PlannerVariant::kWrap, PlannerVariant::kOptimistic, PlannerVariant::kFlat,
@@ -428,7 +498,8 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
   if (run.reached == K) {
     history.push_back({t_first, CostOf(run.results, 0, static_cast<int>(run.results.size()))});
     if (options.optimize && !flat) {
-      Improve(search, order, s0, c0, run.results, ctx, start, history);
+      const TaskClock t0(static_cast<int>(world.robots.size()), world.num_nodes);
+      Improve(search, order, s0, c0, t0, options.objective, run.results, ctx, start, history);
       t_opt = std::chrono::duration<double>(Clock::now() - start).count() - t_first;
     }
   }
@@ -447,6 +518,7 @@ Result<Plan> PlanTask(const Project& project, const ProjectCheck& check, const P
     CollectActions(run.results, flat, K, plan);
     st.cost = static_cast<int>(plan.actions.size());
     st.first_cost = history.front().second;
+    st.makespan_est_s = EstimateMakespan(plan);
   } else {
     st.solved = false;
     std::string failure = std::move(run.failure);

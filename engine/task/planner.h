@@ -57,6 +57,19 @@ std::string_view ToString(PlannerVariant variant);
 /// listing the known ones.
 Result<PlannerVariant> ParsePlannerVariant(std::string_view name);
 
+/// What the planner minimises beyond finding a plan.
+enum class PlanObjective {
+  kActions,   ///< "actions": the number of actions (the paper's cost; the default).
+  kMakespan,  ///< "makespan": the task-level makespan estimate (makespan_estimate.h), then the
+              ///< number of actions.
+};
+
+/// The objective's name as the CLI (`--objective`), the GUI and the plan's JSON spell it.
+std::string_view ToString(PlanObjective objective);
+
+/// The objective named `name` (ToString's words). Fails with kInvalidInput for an unknown name.
+Result<PlanObjective> ParsePlanObjective(std::string_view name);
+
 /// Options of PlanTask.
 struct TaskPlannerOptions {
   /// Variant, the paper's comparison rows (PlannerVariant).
@@ -64,6 +77,13 @@ struct TaskPlannerOptions {
   /// Anytime plan improvement after the first plan (large neighbourhood search) until the time
   /// limit of the RunContext or until windows of the whole horizon bring nothing more.
   bool optimize = false;
+  /// What the planner minimises. kActions: the search as the paper's (ties by depth, then
+  /// order), plan improvement keeps only plans with fewer actions. kMakespan: the search breaks
+  /// ties in f by the makespan estimate of the candidate (then depth, then the estimate's sum of
+  /// action ends), so work spreads over idle robots; plan improvement keeps a plan with a shorter
+  /// estimate and at most two actions more than the first plan, or one as short with fewer
+  /// actions.
+  PlanObjective objective = PlanObjective::kActions;
   /// Memory the search may hold [MiB]: its nodes, queues and caches (estimated) and the
   /// process's growth since planning started (resident memory) must each stay below it; beyond
   /// it the run stops with "out of memory" in stats.failure.

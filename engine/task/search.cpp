@@ -161,7 +161,8 @@ bool TaskSearch::IsGoal(const SymState& s, const Milestone& m,
 }
 
 MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymState& s0,
-                                 const ContState& c0, const std::set<std::uint64_t>& excluded,
+                                 const ContState& c0, const TaskClock& t0,
+                                 const std::set<std::uint64_t>& excluded,
                                  const FillLimits& limits) {
   const auto start = Clock::now();
   const Milestone m = StepMilestone(step, next_step);
@@ -197,9 +198,9 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   for (int level = 0; level < levels; ++level) {
     const Resolution res = ResolutionAt(level);
     if (use_backward_) {
-      const auto t0 = Clock::now();
+      const auto bwd_start = Clock::now();
       BuildBackward(m, res, s0);
-      bwd_s_ += std::chrono::duration<double>(Clock::now() - t0).count();
+      bwd_s_ += std::chrono::duration<double>(Clock::now() - bwd_start).count();
       if (ctx_.Logs("task")) {
         ctx_.Log("task", StrFormat("milestone %d level %d: backward distance %d at the start",
                                    index, level, BackwardDistance(s0)));
@@ -216,7 +217,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
     if (optimistic_) targets = OptimisticTargets(m, res, s0);
     for (const AssemblyTarget& target : targets) {
       target_ = target;
-      const SearchStatus status = Rounds(index, m, res, s0, c0, excluded, limits, result);
+      const SearchStatus status = Rounds(index, m, res, s0, c0, t0, excluded, limits, result);
       if (status != SearchStatus::kExhausted) {
         finish();
         return result;

@@ -22,6 +22,7 @@
 #include "core/run_context.h"
 #include "task/failure.h"
 #include "task/keyframes.h"
+#include "task/makespan_estimate.h"
 #include "task/planner.h"
 #include "task/state.h"
 #include "task/world.h"
@@ -67,6 +68,7 @@ struct MilestoneResult {
   std::vector<std::pair<SymState, ContState>> after;
   SymState end;                    ///< Symbolic state at its end.
   ContState end_c;                 ///< Continuous state at its end.
+  TaskClock end_clock;             ///< The makespan estimate's clock at its end.
   bool out_of_memory = false;      ///< Stopped by TaskPlannerOptions::memory_limit_mb.
   std::string failure;             ///< Why not, when !ok.
   std::vector<FailureCase> cases;  ///< The same as data, blocker first (FailureCase::scene: the
@@ -93,9 +95,12 @@ class TaskSearch {
 
   /// Plans milestone `index` (step node `step`). At its end robots may hold only the inputs of
   /// `next_step` (the next milestone's step; -1 for the last milestone: every robot free). End
-  /// states whose hash is in `excluded` do not count as goals (backtracking).
+  /// states whose hash is in `excluded` do not count as goals (backtracking). `t0`: the makespan
+  /// estimate's clock after the plan before the milestone (ties between candidates as long are
+  /// broken by it).
   MilestoneResult Fill(int index, int step, int next_step, const SymState& s0, const ContState& c0,
-                       const std::set<std::uint64_t>& excluded, const FillLimits& limits = {});
+                       const TaskClock& t0, const std::set<std::uint64_t>& excluded,
+                       const FillLimits& limits = {});
   /// The paper's "Flat lazy": one lazy search over the whole task from s0 to the final product
   /// released, any step whose inputs exist may be assembled next (no milestones). The actions'
   /// milestone index is the number of steps assembled before them.
@@ -104,7 +109,8 @@ class TaskSearch {
   /// milestone `index`) from s0, ending with robots holding only the inputs of `next_step` (-1:
   /// nothing). Counting heuristic; the actions carry their milestone indices.
   MilestoneResult FillWindow(int index, const std::vector<int>& steps, int next_step,
-                             const SymState& s0, const ContState& c0, const FillLimits& limits);
+                             const SymState& s0, const ContState& c0, const TaskClock& t0,
+                             const FillLimits& limits);
 
   /// The variant's heuristic of `s` at the start of milestone (`step`, `next_step`), with the
   /// backward abstraction built from `s` at the widest resolution (tests: admissibility).
@@ -155,6 +161,7 @@ class TaskSearch {
     int parent = -1;
     TaskAction a;
     std::uint64_t hash = 0;  ///< s.Hash(), computed once (the search's hot path).
+    TaskClock clock;         ///< The makespan estimate's clock after the path to s.
   };
   enum class SearchStatus { kFound, kExhausted, kNodeLimit, kStopped, kOutOfMemory };
   /// Actions of a state with the states they lead to.
@@ -164,6 +171,7 @@ class TaskSearch {
     SymState s;
     ContState c;
     std::uint64_t entering_edge = 0;
+    TaskClock clock;
   };
   /// How the validation of a candidate plan ended: every edge held, one failed, the run was
   /// stopped, or the fill gives up (its failure limit, or Optimistic's bad target).
@@ -234,8 +242,9 @@ class TaskSearch {
   /// The effort rounds of one resolution (the lazy search with validation and commits): kFound
   /// with `result` filled, kStopped / kOutOfMemory, or kExhausted.
   SearchStatus Rounds(int index, const Milestone& m, const Resolution& res, const SymState& s0,
-                      const ContState& c0, const std::set<std::uint64_t>& excluded,
-                      const FillLimits& limits, MilestoneResult& result);
+                      const ContState& c0, const TaskClock& t0,
+                      const std::set<std::uint64_t>& excluded, const FillLimits& limits,
+                      MilestoneResult& result);
   /// Optimistic: assembly targets of milestone `m` chosen by the wrench LP alone (no reach).
   std::vector<AssemblyTarget> OptimisticTargets(const Milestone& m, const Resolution& res,
                                                 const SymState& s0);
@@ -247,11 +256,14 @@ class TaskSearch {
   /// Estimated bytes held by the search (nodes, queue, caches), for the memory limit.
   std::size_t MemoryBytes(std::size_t open, std::size_t closed) const;
   SymState Apply(const SymState& s, const TaskAction& a) const;
+  /// Runs action `a` of `s` on `clock`: its robots (an assembly's: the holders of its inputs)
+  /// and objects as MakeAction lists them.
+  void Advance(const SymState& s, const TaskAction& a, TaskClock& clock) const;
   /// One weighted best-first search from s0 (g0 actions after the milestone's start) to a goal,
   /// skipping edges failed at `effort`, dead ends and `forbidden` states; the goal's node path
   /// in `path` (lazy_search.cpp).
-  SearchStatus BestFirst(const SymState& s0, const Milestone& m, const Resolution& res, int effort,
-                         const std::set<std::uint64_t>& excluded,
+  SearchStatus BestFirst(const SymState& s0, const TaskClock& t0, const Milestone& m,
+                         const Resolution& res, int effort, const std::set<std::uint64_t>& excluded,
                          const std::unordered_map<std::uint64_t, bool>& dead_ends,
                          const std::unordered_set<std::uint64_t>& forbidden, long long node_budget,
                          int g0, int max_cost, std::vector<int>& path);

@@ -81,7 +81,7 @@ int TaskSearch::WindowDone(const SymState& s) const {
 }
 
 MilestoneResult TaskSearch::FillWindow(int index, const std::vector<int>& steps, int next_step,
-                                       const SymState& s0, const ContState& c0,
+                                       const SymState& s0, const ContState& c0, const TaskClock& t0,
                                        const FillLimits& limits) {
   const auto start = Clock::now();
   window_ = steps;
@@ -95,7 +95,7 @@ MilestoneResult TaskSearch::FillWindow(int index, const std::vector<int>& steps,
   MilestoneResult result;
   const int levels = 3;
   for (int level = 0; level < levels; ++level) {
-    if (Rounds(index, m, ResolutionAt(level), s0, c0, {}, limits, result) !=
+    if (Rounds(index, m, ResolutionAt(level), s0, c0, t0, {}, limits, result) !=
         SearchStatus::kExhausted) {
       break;
     }
@@ -125,7 +125,8 @@ MilestoneResult TaskSearch::FillFlat(const SymState& s0, const ContState& c0) {
   }
   const int levels = 3;
   for (int level = 0; level < levels; ++level) {
-    const SearchStatus status = Rounds(0, m, ResolutionAt(level), s0, c0, {}, {}, result);
+    const SearchStatus status = Rounds(0, m, ResolutionAt(level), s0, c0,
+                                       TaskClock(n_robots_, world_.num_nodes), {}, {}, result);
     if (status != SearchStatus::kExhausted) break;
     if (level + 1 < levels) ++widenings_;
   }

@@ -87,8 +87,7 @@ TEST(PlanCli, PlansValidatesAndWritesThePlan) {
 // a usage error listing the known ones.
 TEST(PlanCli, LogTopicsGoToStderrAndLeaveThePlanAlone) {
   const fs::path dir = TempDir("log");
-  const CliRun quiet =
-      Wrap({"plan", Project("half_stool"), "-o", (dir / "quiet.json").string()});
+  const CliRun quiet = Wrap({"plan", Project("half_stool"), "-o", (dir / "quiet.json").string()});
   ASSERT_EQ(quiet.code, 0) << quiet.err;
   EXPECT_EQ(quiet.err.find("[motion]"), std::string::npos) << quiet.err;
   const CliRun logged = Wrap({"plan", Project("half_stool"), "-o", (dir / "logged.json").string(),
@@ -111,14 +110,18 @@ TEST(PlanCli, LogTopicsGoToStderrAndLeaveThePlanAlone) {
 TEST(PlanCli, SeedAndWrenchModeReachTheStats) {
   const fs::path dir = TempDir("seed");
   const fs::path out = dir / "plan.json";
-  const CliRun r = Wrap({"plan", Project("half_stool"), "-o", out.string(), "--seed", "5",
-                         "--wrench", "gravity", "--force-scale", "0.5", "--task-only"});
+  const CliRun r =
+      Wrap({"plan", Project("half_stool"), "-o", out.string(), "--seed", "5", "--wrench", "gravity",
+            "--force-scale", "0.5", "--objective", "makespan", "--task-only"});
   ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("estimated makespan"), std::string::npos) << r.out;
   std::ifstream in(out);
   const nlohmann::json plan = nlohmann::json::parse(in);
   EXPECT_EQ(plan["stats"]["seed"].get<int>(), 5);
   EXPECT_EQ(plan["stats"]["wrench_mode"], "gravity");
   EXPECT_DOUBLE_EQ(plan["stats"]["force_scale"].get<double>(), 0.5);
+  EXPECT_EQ(plan["stats"]["objective"], "makespan");
+  EXPECT_GT(plan["stats"]["makespan_est_s"].get<double>(), 0.0);
 }
 
 // --optimize reports the improvement and records the cost over time; every variant is known.
@@ -150,6 +153,7 @@ TEST(PlanCli, BadInputExitsTwo) {
   EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--force-scale", "-1"}).code, 2);
   EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--time-limit", "0"}).code, 2);
   EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--planner", "magic"}).code, 2);
+  EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--objective", "fast"}).code, 2);
   EXPECT_EQ(Wrap({"plan", Project("half_stool"), "--memory-limit", "0"}).code, 2);
   const CliRun missing = Wrap({"plan", "/nonexistent/project.json"});
   EXPECT_EQ(missing.code, 2);

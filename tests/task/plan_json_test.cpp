@@ -89,6 +89,8 @@ Plan StoolPlan() {
   s.t_fwd_s = 0.2;
   s.t_ik_s = 0.3;
   s.planner = "counting";
+  s.objective = "makespan";
+  s.makespan_est_s = 42.5;
   s.seed = 18446744073709551615ull;
   s.wrench_mode = "full";
   s.force_scale = 1.5;
@@ -174,6 +176,8 @@ void ExpectPlansEqual(const Plan& a, const Plan& b) {
   EXPECT_EQ(s.t_fwd_s, t.t_fwd_s);
   EXPECT_EQ(s.t_ik_s, t.t_ik_s);
   EXPECT_EQ(s.planner, t.planner);
+  EXPECT_EQ(s.objective, t.objective);
+  EXPECT_EQ(s.makespan_est_s, t.makespan_est_s);
   EXPECT_EQ(s.seed, t.seed);
   EXPECT_EQ(s.wrench_mode, t.wrench_mode);
   EXPECT_EQ(s.force_scale, t.force_scale);

@@ -191,12 +191,13 @@ TEST(BackwardHeuristic, NeverOverestimatesAMilestone) {
   const int K = static_cast<int>(order.size());
   SymState s = rig.s0;
   ContState c = rig.c0;
+  TaskClock t(static_cast<int>(rig.world->robots.size()), rig.world->num_nodes);
   FillLimits uniform;
   uniform.weight = 0;
   int informative = 0;
   for (int k = 0; k < K; ++k) {
     const int next = k + 1 < K ? order[k + 1] : -1;
-    const MilestoneResult r = blind.Fill(k, order[k], next, s, c, {}, uniform);
+    const MilestoneResult r = blind.Fill(k, order[k], next, s, c, t, {}, uniform);
     ASSERT_TRUE(r.ok) << "milestone " << k << ": " << r.failure;
     const int optimum = static_cast<int>(r.actions.size());
     const int h_coarse = coarse.StartHeuristic(order[k], next, s);
@@ -207,6 +208,7 @@ TEST(BackwardHeuristic, NeverOverestimatesAMilestone) {
     informative += h_coarse >= 2 ? 1 : 0;
     s = r.end;
     c = r.end_c;
+    t = r.end_clock;
   }
   EXPECT_GT(informative, 0);  // not the trivial heuristic
 }

@@ -73,6 +73,7 @@ void PlannerPanel::Draw(AppState& app, const PanelRect& r) {
   PlannerRequest& q = app.request;
   static const char* kPlanners[] = {"wrap", "optimistic", "flat", "counting", "exact", "fine"};
   static const char* kWrench[] = {"full", "gravity", "none"};
+  static const char* kObjectives[] = {"actions", "makespan"};
   const bool running = app.job.running();
   ImGui::BeginDisabled(running);
   ImGui::SetNextItemWidth(120);
@@ -111,6 +112,18 @@ void PlannerPanel::Draw(AppState& app, const PanelRect& r) {
   ImGui::InputDouble("force scale", &q.force_scale, 0.1, 1.0, "%.2f");
   q.force_scale = std::clamp(q.force_scale, 0.0, 1e6);
   ImGui::Checkbox("optimize", &q.optimize);
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(90);
+  if (ImGui::BeginCombo("objective", q.objective.c_str())) {
+    for (const char* v : kObjectives) {
+      if (ImGui::Selectable(v, q.objective == v)) q.objective = v;
+    }
+    ImGui::EndCombo();
+  }
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip("What the planner minimises, as `wrap plan --objective`: the number of "
+                      "actions, or the task plan's makespan estimate (work spread over robots).");
+  }
   ImGui::SameLine();
   ImGui::Checkbox("task only (no motion)", &q.task_only);
   ImGui::EndDisabled();

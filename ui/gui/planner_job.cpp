@@ -174,10 +174,16 @@ void PlannerJob::Run(std::stop_token stop, Project project, std::filesystem::pat
       Finish(JobState::kFailed, variant.error().message, nullptr);
       return;
     }
+    const Result<PlanObjective> objective = ParsePlanObjective(request.objective);
+    if (!objective) {
+      Finish(JobState::kFailed, objective.error().message, nullptr);
+      return;
+    }
     TaskPlannerOptions task;
     task.project_file = file;
     task.planner = *variant;
     task.optimize = request.optimize;
+    task.objective = *objective;
     task.force_scale = request.force_scale;
     task.wrench_mode = request.wrench == "gravity" ? MatingWrenchMode::kGravityOnly
                        : request.wrench == "none"  ? MatingWrenchMode::kNone

@@ -31,6 +31,8 @@ struct PlannerRequest {
   int grasps = 0;                ///< Grasp-set size; 0: the project's.
   bool optimize = false;         ///< Improve the first plan until the time limit.
   bool task_only = false;        ///< No motion (keyframes only).
+  /// What the planner minimises: "actions" or "makespan" (`wrap plan --objective`).
+  std::string objective = "actions";
 };
 
 /// Where a run is.
