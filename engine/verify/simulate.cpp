@@ -92,6 +92,7 @@ Result<void> Simulator::BuildModel(const SceneState& state) {
   mo.physics = true;
   mo.timestep_s = options_.timestep_s;
   mo.shadows = false;
+  mo.support_points_P = RestingSupportPoints(scene_, tree_, plan_);
   auto doc = BuildCellMjcf(scene_, state, mo);
   if (!doc) return std::unexpected(doc.error());
   for (const std::string& w : doc->warnings) report_.warnings.push_back(w);

@@ -42,6 +42,11 @@ inline constexpr double kReleaseRamp_s = 0.1;
 // many corners of their hull are used.
 inline constexpr double kSupportReach_m = 0.001;
 inline constexpr size_t kMaxSupportPoints = 16;
+// RestingSupportPoints: hull vertices this close to the table top carry a resting part, as the
+// planner's table supports count them (task/world.h TableContacts) [m] ...
+inline constexpr double kRestReach_m = 2e-3;
+// ... and two closer than this are one [m].
+inline constexpr double kSamePoint_m = 1e-5;
 
 /// The angle of a rotation [rad].
 double AngleOf(const Mat3& R);
@@ -63,6 +68,14 @@ struct Interface {
 /// The interface of step inputs `moved` and `base` (node ids) with the step's mating.
 Interface FindInterface(const CellScene& scene, const AssemblyTree& tree, const Mating& mating,
                         int moved, int base);
+
+/// Per part of `scene`, the points of its frame P on which `plan` rests it on the table: in
+/// every state of the plan where its object rests (ReplayPlanStates), the part's convex hull
+/// vertices within kRestReach_m of the table top that are corners of their 2-D hull (at most
+/// kMaxSupportPoints, spread along it), as the wrench LP's table supports; their union over
+/// the plan. The physics model puts a contact sphere at each (MjcfOptions::support_points_P).
+std::vector<std::vector<Vec3>> RestingSupportPoints(const CellScene& scene,
+                                                    const AssemblyTree& tree, const Plan& plan);
 
 /// Utilisation of a wrench (force, torque) against a symmetric box: the largest |component| /
 /// bound, a zero bound taken as the floor.
