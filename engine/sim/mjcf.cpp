@@ -80,10 +80,6 @@ std::string Esc(const std::string& s) {
   return out;
 }
 
-// Physics: radius of the spheres at a part's support points [m]. Small against any part (the
-// part rests this much higher than its mesh would).
-constexpr double kSupportSphereRadius = 5e-4;
-
 // True when MuJoCo 2.2 accepts the mesh: some enclosed volume and every directed edge used once
 // (it rejects "inconsistent orientation" and "volume too small").
 bool MujocoAcceptsMesh(const TriangleMesh& mesh) {
@@ -510,7 +506,8 @@ class Writer {
            Num(4.0 * options_.timestep_s) + " 1\"";
   }
 
-  // Physics: spheres at part p's support points (MjcfOptions::support_points_P), which meet
+  // Physics: spheres of kSupportSphereRadius_m at part p's support points
+  // (MjcfOptions::support_points_P), which meet
   // only the table and floor. MuJoCo 2.2 collides a mesh with the table box through libccd (MPR
   // with multiccd) and finds one to four points anywhere on a flat face (under a beam pressed by
   // an insertion, two on its centre line: it rolled over its long edge). Sphere-box contacts are
@@ -519,7 +516,7 @@ class Writer {
   void SupportSpheres(int p) {
     if (p >= static_cast<int>(options_.support_points_P.size())) return;
     for (const Vec3& v : options_.support_points_P[p]) {
-      Line("<geom type=\"sphere\" size=\"" + Num(kSupportSphereRadius) + "\" pos=\"" + Vec(v) +
+      Line("<geom type=\"sphere\" size=\"" + Num(kSupportSphereRadius_m) + "\" pos=\"" + Vec(v) +
            "\" group=\"3\" rgba=\"0 0 0 0\"" + PartContact() + "/>");
     }
   }

@@ -70,12 +70,17 @@ struct MjcfOptions {
   /// off; no keyframe. Default false: the drawing model (visual geoms only, parts mocap).
   bool physics = false;
   double timestep_s = 0.001;  ///< Physics: integration step [s]; welds are as stiff as it allows.
-  /// Physics: per part (scene order; missing or empty: none), points in its frame P [m] that
-  /// carry it on the table: a small sphere at each meets only the table and floor, so MuJoCo's
-  /// contacts of a resting part lie at the corners of its support polygon, where the wrench LP
-  /// has them (verify/ passes the hull vertices the plan rests each part on).
+  /// Physics: per part (scene order; missing or empty: none), centres in its frame P [m] of
+  /// spheres of kSupportSphereRadius_m that carry it on the table: they meet only the table and
+  /// floor, so MuJoCo's contacts of a resting part lie at the corners of its support polygon,
+  /// where the wrench LP has them (verify/ passes the hull vertices the plan rests each part on,
+  /// each raised by the radius along the table's normal, so that the sphere touches where the
+  /// vertex does).
   std::vector<std::vector<Vec3>> support_points_P;
 };
+
+/// Radius of the spheres at MjcfOptions::support_points_P [m]: small against any part.
+inline constexpr double kSupportSphereRadius_m = 5e-4;
 
 /// A file the XML refers to: a mesh in MuJoCo's binary MSH format.
 struct MjcfAsset {

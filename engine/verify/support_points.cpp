@@ -22,6 +22,9 @@ std::vector<std::vector<Vec3>> RestingSupportPoints(const CellScene& scene,
       auto hull = ComputeConvexHull(*scene.parts[p].mesh);
       if (hull) it->second = std::move(hull->mesh.vertices);
     }
+    // The sphere on a vertex touches the table where the vertex does: its centre is raised by
+    // its radius along the table's normal (world z, in P).
+    const Vec3 up_P = X_WP.linear().transpose() * Vec3::UnitZ() * kSupportSphereRadius_m;
     std::vector<Vec3> low;  // Hull vertices on the table, part frame.
     std::vector<Eigen::Vector2d> xy;
     for (const Vec3& v : it->second) {
@@ -40,7 +43,7 @@ std::vector<std::vector<Vec3>> RestingSupportPoints(const CellScene& scene,
       corners = std::move(kept);
     }
     for (int c : corners) {
-      const Vec3& v = low[c];
+      const Vec3 v = low[c] + up_P;
       const bool seen = std::any_of(out[p].begin(), out[p].end(), [&](const Vec3& u) {
         return (u - v).squaredNorm() < kSamePoint_m * kSamePoint_m;
       });

@@ -72,8 +72,9 @@ Interface FindInterface(const CellScene& scene, const AssemblyTree& tree, const 
 /// Per part of `scene`, the points of its frame P on which `plan` rests it on the table: in
 /// every state of the plan where its object rests (ReplayPlanStates), the part's convex hull
 /// vertices within kRestReach_m of the table top that are corners of their 2-D hull (at most
-/// kMaxSupportPoints, spread along it), as the wrench LP's table supports; their union over
-/// the plan. The physics model puts a contact sphere at each (MjcfOptions::support_points_P).
+/// kMaxSupportPoints, spread along it), as the wrench LP's table supports, each raised by
+/// kSupportSphereRadius_m along the table's normal; their union over the plan: the centres of
+/// the physics model's contact spheres (MjcfOptions::support_points_P).
 std::vector<std::vector<Vec3>> RestingSupportPoints(const CellScene& scene,
                                                     const AssemblyTree& tree, const Plan& plan);
 
