@@ -491,11 +491,13 @@ class Writer {
   // parts not with each other (contype 2 meets only conaffinity 2).
   std::string SupportContact() const {
     if (!options_.physics) return "";
-    return " contype=\"1\" conaffinity=\"2\"" + ContactParameters();
+    return " contype=\"" + std::to_string(kPartConaffinity) + "\" conaffinity=\"" +
+           std::to_string(kPartContype) + "\"" + ContactParameters();
   }
   std::string PartContact() const {
     if (!options_.physics) return "";
-    return " contype=\"2\" conaffinity=\"1\"" + ContactParameters();
+    return " contype=\"" + std::to_string(kPartContype) + "\" conaffinity=\"" +
+           std::to_string(kPartConaffinity) + "\"" + ContactParameters();
   }
   // Friction and stiffness of every part-table contact, on both geoms: MuJoCo averages the two
   // geoms' solref, so a table left at the default 0.02 s made the pair's time constant 12 ms
@@ -513,11 +515,16 @@ class Writer {
   // an insertion, two on its centre line: it rolled over its long edge). Sphere-box contacts are
   // exact and put MuJoCo's friction where the wrench LP has it, at the corners of the support
   // polygon. Not drawn (group 3).
-  void SupportSpheres(int p) {
+  void SupportSpheres(int p, const std::string& part_name) {
+    doc_.support_geoms.emplace_back();
     if (p >= static_cast<int>(options_.support_points_P.size())) return;
     for (const Vec3& v : options_.support_points_P[p]) {
-      Line("<geom type=\"sphere\" size=\"" + Num(kSupportSphereRadius_m) + "\" pos=\"" + Vec(v) +
-           "\" group=\"3\" rgba=\"0 0 0 0\"" + PartContact() + "/>");
+      const std::string name =
+          part_name + "/support" + std::to_string(doc_.support_geoms.back().size());
+      Line("<geom name=\"" + Esc(name) + "\" type=\"sphere\" size=\"" +
+           Num(kSupportSphereRadius_m) + "\" pos=\"" + Vec(v) + "\" group=\"3\" rgba=\"0 0 0 0\"" +
+           PartContact() + "/>");
+      doc_.support_geoms.back().push_back(name);
     }
   }
 
@@ -608,7 +615,7 @@ class Writer {
     } else {
       BoxFallback(*part.mesh, Iso3::Identity(), head, name);
     }
-    if (options_.physics) SupportSpheres(p);
+    if (options_.physics) SupportSpheres(p, name);
     --depth_;
     Line("</body>");
     doc_.part_bodies.push_back(name);
