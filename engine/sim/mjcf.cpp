@@ -1,3 +1,5 @@
+// The MJCF writer: the cell (table, robots, grippers, parts) as MuJoCo XML, for drawing and, in
+// its physics variant, for `wrap sim` (free parts with their contacts, TCP mocap bodies, welds).
 #include "sim/mjcf.h"
 
 #include <Eigen/Eigenvalues>
@@ -489,14 +491,41 @@ class Writer {
   // parts not with each other (contype 2 meets only conaffinity 2).
   std::string SupportContact() const {
     if (!options_.physics) return "";
-    return " contype=\"1\" conaffinity=\"2\" friction=\"" + Num(scene_.table.friction) +
-           " 0.005 0.0001\"";
+    return " contype=\"" + std::to_string(kPartConaffinity) + "\" conaffinity=\"" +
+           std::to_string(kPartContype) + "\"" + ContactParameters();
   }
   std::string PartContact() const {
     if (!options_.physics) return "";
-    // Contacts as stiff as the step allows (a softer default lets heavy parts sink mm deep).
-    return " contype=\"2\" conaffinity=\"1\" friction=\"" + Num(scene_.table.friction) +
-           " 0.005 0.0001\" solref=\"" + Num(4.0 * options_.timestep_s) + " 1\"";
+    return " contype=\"" + std::to_string(kPartContype) + "\" conaffinity=\"" +
+           std::to_string(kPartConaffinity) + "\"" + ContactParameters();
+  }
+  // Friction and stiffness of every part-table contact, on both geoms: MuJoCo averages the two
+  // geoms' solref, so a table left at the default 0.02 s made the pair's time constant 12 ms
+  // instead of 4 (a 39 g beam pressed with 10 N sank 0.5 mm, then mm, and rolled over). As stiff
+  // as the step allows with margin (a softer contact lets heavy parts sink mm deep).
+  std::string ContactParameters() const {
+    return " friction=\"" + Num(scene_.table.friction) + " 0.005 0.0001\" solref=\"" +
+           Num(4.0 * options_.timestep_s) + " 1\"";
+  }
+
+  // Physics: spheres of kSupportSphereRadius_m at part p's support points
+  // (MjcfOptions::support_points_P), which meet
+  // only the table and floor. MuJoCo 2.2 collides a mesh with the table box through libccd (MPR
+  // with multiccd) and finds one to four points anywhere on a flat face (under a beam pressed by
+  // an insertion, two on its centre line: it rolled over its long edge). Sphere-box contacts are
+  // exact and put MuJoCo's friction where the wrench LP has it, at the corners of the support
+  // polygon. Not drawn (group 3).
+  void SupportSpheres(int p, const std::string& part_name) {
+    doc_.support_geoms.emplace_back();
+    if (p >= static_cast<int>(options_.support_points_P.size())) return;
+    for (const Vec3& v : options_.support_points_P[p]) {
+      const std::string name =
+          part_name + "/support" + std::to_string(doc_.support_geoms.back().size());
+      Line("<geom name=\"" + Esc(name) + "\" type=\"sphere\" size=\"" +
+           Num(kSupportSphereRadius_m) + "\" pos=\"" + Vec(v) + "\" group=\"3\" rgba=\"0 0 0 0\"" +
+           PartContact() + "/>");
+      doc_.support_geoms.back().push_back(name);
+    }
   }
 
   // Physics: a part's mass and inertia about its COM (a small box's when the mesh gives none).
@@ -586,6 +615,7 @@ class Writer {
     } else {
       BoxFallback(*part.mesh, Iso3::Identity(), head, name);
     }
+    if (options_.physics) SupportSpheres(p, name);
     --depth_;
     Line("</body>");
     doc_.part_bodies.push_back(name);

@@ -70,7 +70,21 @@ struct MjcfOptions {
   /// off; no keyframe. Default false: the drawing model (visual geoms only, parts mocap).
   bool physics = false;
   double timestep_s = 0.001;  ///< Physics: integration step [s]; welds are as stiff as it allows.
+  /// Physics: per part (scene order; missing or empty: none), centres in its frame P [m] of
+  /// spheres of kSupportSphereRadius_m that carry it on the table: they meet only the table and
+  /// floor, so MuJoCo's contacts of a resting part lie at the corners of its support polygon,
+  /// where the wrench LP has them (verify/ passes the hull vertices the plan rests each part on,
+  /// each raised by the radius along the table's normal, so that the sphere touches where the
+  /// vertex does).
+  std::vector<std::vector<Vec3>> support_points_P;
 };
+
+/// Radius of the spheres at MjcfOptions::support_points_P [m]: small against any part.
+inline constexpr double kSupportSphereRadius_m = 5e-4;
+/// Physics: the contact bits of a part's geoms (contype, conaffinity), and of the table's and
+/// floor's (the other way round): parts meet the table and floor, not each other.
+inline constexpr int kPartContype = 2;
+inline constexpr int kPartConaffinity = 1;
 
 /// A file the XML refers to: a mesh in MuJoCo's binary MSH format.
 struct MjcfAsset {
@@ -94,6 +108,9 @@ struct MjcfDocument {
   std::vector<std::vector<std::string>> grip_welds;
   /// Physics: join_welds[p][q] (p < q) names the weld of part p to part q; else empty.
   std::vector<std::vector<std::string>> join_welds;
+  /// Physics: per part, the names of its support spheres (MjcfOptions::support_points_P, same
+  /// order), whose contact bits a simulation may switch; else empty.
+  std::vector<std::vector<std::string>> support_geoms;
   std::vector<std::string> warnings;  ///< Shapes drawn approximately, e.g. a flat mesh.
 };
 

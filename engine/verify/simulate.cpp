@@ -82,6 +82,7 @@ Result<void> Simulator::Setup() {
   }
   SetTcps(0.0);
   mj_forward(model_.get(), data_.get());
+  SwitchSupports();
   return {};
 }
 
@@ -92,6 +93,14 @@ Result<void> Simulator::BuildModel(const SceneState& state) {
   mo.physics = true;
   mo.timestep_s = options_.timestep_s;
   mo.shadows = false;
+  support_sets_ = RestingSupportSets(scene_, tree_, plan_);
+  for (const std::vector<SupportSet>& sets : support_sets_) {
+    mo.support_points_P.emplace_back();
+    for (const SupportSet& s : sets) {
+      mo.support_points_P.back().insert(mo.support_points_P.back().end(), s.centres_P.begin(),
+                                        s.centres_P.end());
+    }
+  }
   auto doc = BuildCellMjcf(scene_, state, mo);
   if (!doc) return std::unexpected(doc.error());
   for (const std::string& w : doc->warnings) report_.warnings.push_back(w);
@@ -132,6 +141,25 @@ Result<void> Simulator::FindBodies(const MjcfDocument& doc) {
     part_dof_.push_back(m->jnt_dofadr[m->body_jntadr[part_body_.back()]]);
     for (int q = p + 1; q < np; ++q) {
       join_eq_[p][q] = mj_name2id(m, mjOBJ_EQUALITY, doc.join_welds[p][q].c_str());
+    }
+  }
+  // The support spheres, in the order of support_sets_ (BuildModel wrote them so).
+  supports_.assign(np, {});
+  for (int p = 0; p < np && p < static_cast<int>(support_sets_.size()); ++p) {
+    size_t k = 0;
+    for (const SupportSet& s : support_sets_[p]) {
+      SupportGeoms geoms{s.up_P, {}};
+      for (size_t i = 0; i < s.centres_P.size(); ++i, ++k) {
+        const int g = k < doc.support_geoms[p].size()
+                          ? mj_name2id(m, mjOBJ_GEOM, doc.support_geoms[p][k].c_str())
+                          : -1;
+        if (g < 0) {
+          return Fail(ErrorCode::kInternal, "sim: no support sphere " + std::to_string(k) +
+                                                " for part '" + scene_.parts[p].name + "'");
+        }
+        geoms.geoms.push_back(g);
+      }
+      supports_[p].push_back(std::move(geoms));
     }
   }
   return {};
@@ -304,6 +332,7 @@ Result<void> Simulator::Loop() {
     }
     if (report_.failure) break;
     SetTcps(t);
+    SwitchSupports();
     FadeBeforeReleases(t);
     mju_zero(data_->xfrc_applied, 6 * model_->nbody);
     for (Vec6& w : mating_on_part_) w.setZero();

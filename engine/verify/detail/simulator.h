@@ -42,6 +42,18 @@ inline constexpr double kReleaseRamp_s = 0.1;
 // many corners of their hull are used.
 inline constexpr double kSupportReach_m = 0.001;
 inline constexpr size_t kMaxSupportPoints = 16;
+// RestingSupportSets: hull vertices this close to the table top carry a resting part, as the
+// planner's table supports count them (task/world.h TableContacts) [m] ...
+inline constexpr double kRestReach_m = 2e-3;
+// ... of which those this close to the lowest touch it [m] ...
+inline constexpr double kTouchReach_m = 1e-4;
+// ... two closer than this are one [m] ...
+inline constexpr double kSamePoint_m = 1e-5;
+// ... and two resting orientations whose up directions differ by less than this are one [rad].
+inline constexpr double kSameOrientation_rad = 1e-3;
+// A part's support spheres of an orientation meet the table while its up direction is within
+// this of that orientation's [rad] (a part turned further has failed: drift_tolerance_rad).
+inline constexpr double kSupportTilt_rad = 0.3;
 
 /// The angle of a rotation [rad].
 double AngleOf(const Mat3& R);
@@ -63,6 +75,23 @@ struct Interface {
 /// The interface of step inputs `moved` and `base` (node ids) with the step's mating.
 Interface FindInterface(const CellScene& scene, const AssemblyTree& tree, const Mating& mating,
                         int moved, int base);
+
+/// The support spheres of a part in one resting orientation.
+struct SupportSet {
+  Vec3 up_P = Vec3::UnitZ();    ///< The table's normal (world up) in the part frame P.
+  std::vector<Vec3> centres_P;  ///< Sphere centres, part frame [m].
+};
+
+/// Per part of `scene`, the points of its frame P on which `plan` rests it on the table, by
+/// orientation: in every state of the plan where its object rests (ReplayPlanStates), the
+/// part's convex hull vertices that touch the table (within kRestReach_m of its top, as the
+/// wrench LP's table supports, and within kTouchReach_m of the part's lowest) and are corners
+/// of their 2-D hull (at most kMaxSupportPoints, spread along it),
+/// each raised by kSupportSphereRadius_m along the table's normal: the centres of the physics
+/// model's contact spheres (MjcfOptions::support_points_P), which touch the table where the
+/// corners do.
+std::vector<std::vector<SupportSet>> RestingSupportSets(const CellScene& scene,
+                                                        const AssemblyTree& tree, const Plan& plan);
 
 /// Utilisation of a wrench (force, torque) against a symmetric box: the largest |component| /
 /// bound, a zero bound taken as the floor.
@@ -128,6 +157,7 @@ class Simulator {
   int CurrentAction() const;
   Iso3 Tcp(int r, double t) const;
   void SetTcps(double t);
+  void SwitchSupports();  // support_points.cpp
   Iso3 BodyPose(int body) const;
   Iso3 PartPose(int p) const { return BodyPose(part_body_[p]); }
   Iso3 TcpBodyPose(int r) const;
@@ -199,17 +229,24 @@ class Simulator {
   std::vector<std::vector<int>> grip_eq_;  // [robot][part] weld id
   std::vector<std::vector<int>> join_eq_;  // [p][q] weld id, p < q
   std::vector<int> part_body_, part_dof_;  // per part
-  std::vector<WrenchLimits> limits_;       // per robot
-  std::vector<int> grip_part_;             // per robot, -1 free
-  std::vector<PlanGrasp> grasp_;           // per robot, the grasp its weld holds
-  std::vector<Vec3> hold_f_, hold_tau_;    // per robot, wrench when its insertion began
-  std::vector<Vec3> prev_f_, prev_tau_;    // per robot, its last measured wrench
-  std::vector<Fade> fades_;                // grippers being let go of
-  std::vector<std::deque<Vec6>> recent_;   // per robot, its last measured wrenches (averaged)
-  std::vector<Vec6> mating_on_part_;     // per part, the mating wrench applied now (about its COM)
-  std::vector<bool> was_inserting_;      // per robot
-  std::map<int, Interface> interfaces_;  // per assemble action
-  std::vector<Join> joins_;              // connections made so far
+  // The support spheres of one resting orientation (SupportSet) as geoms of the model.
+  struct SupportGeoms {
+    Vec3 up_P = Vec3::UnitZ();
+    std::vector<int> geoms;
+  };
+  std::vector<std::vector<SupportGeoms>> supports_;    // per part, by orientation
+  std::vector<std::vector<SupportSet>> support_sets_;  // per part, from the plan
+  std::vector<WrenchLimits> limits_;                   // per robot
+  std::vector<int> grip_part_;                         // per robot, -1 free
+  std::vector<PlanGrasp> grasp_;                       // per robot, the grasp its weld holds
+  std::vector<Vec3> hold_f_, hold_tau_;                // per robot, wrench when its insertion began
+  std::vector<Vec3> prev_f_, prev_tau_;                // per robot, its last measured wrench
+  std::vector<Fade> fades_;                            // grippers being let go of
+  std::vector<std::deque<Vec6>> recent_;  // per robot, its last measured wrenches (averaged)
+  std::vector<Vec6> mating_on_part_;      // per part, the mating wrench applied now (about its COM)
+  std::vector<bool> was_inserting_;       // per robot
+  std::map<int, Interface> interfaces_;   // per assemble action
+  std::vector<Join> joins_;               // connections made so far
   // Who holds what (task/plan_state.h), replayed as the actions' moments pass. The pose of an
   // object nobody holds is where the plan has it: initially the plan's, after a release where
   // its last holder's TCP let go of it (Event).
