@@ -99,16 +99,17 @@ TEST(Script, OptionsAndCheckArgumentsRefuseWhatIsNotANumber) {
   OpenStool(app);
   ASSERT_TRUE(RunScript(app,
                         "option seed 7\noption grasps 32\noption time_limit_s 12.5\n"
-                        "option budget 2\noption task_only 1\n"));
+                        "option budget 2\noption task_only 1\noption objective makespan\n"));
   EXPECT_EQ(app.request.seed, 7u);
   EXPECT_EQ(app.request.grasps, 32);
   EXPECT_DOUBLE_EQ(app.request.time_limit_s, 12.5);
   EXPECT_DOUBLE_EQ(app.request.budget, 2.0);
   EXPECT_TRUE(app.request.task_only);
+  EXPECT_EQ(app.request.objective, "makespan");
   const PlannerRequest before = app.request;
-  for (const char* bad :
-       {"option seed abc\n", "option seed -1\n", "option seed 1.5\n", "option grasps many\n",
-        "option time_limit_s 0\n", "option budget 2x\n", "option task_only yes\n"}) {
+  for (const char* bad : {"option seed abc\n", "option seed -1\n", "option seed 1.5\n",
+                          "option grasps many\n", "option time_limit_s 0\n", "option budget 2x\n",
+                          "option task_only yes\n", "option objective speed\n"}) {
     auto r = RunScript(app, bad);
     ASSERT_FALSE(r) << bad;
     EXPECT_NE(r.error().message.find("line 1"), std::string::npos) << r.error().message;

@@ -112,6 +112,8 @@ Result<ScriptEffect> OptionVerb(AppState& app, const ScriptLine& line, const fs:
     q.planner = v;
   else if (w[1] == "wrench")
     q.wrench = v;
+  else if (w[1] == "objective" && (v == "actions" || v == "makespan"))
+    q.objective = v;
   else if (w[1] == "task_only" && (v == "0" || v == "1" || v == "true" || v == "false"))
     q.task_only = v == "1" || v == "true";
   else if (w[1] == "time_limit_s" || w[1] == "budget" || w[1] == "seed" || w[1] == "grasps")

@@ -17,8 +17,8 @@
 //                                      table.height|friction; planner.time_limit_s|seed|grasps),
 //                                      `set mating.s1.axis 0 0 1`, `set robot.r1.base_xyz 0 0 .75`
 //   undo | redo
-//   option NAME VALUE                  planner option: planner, wrench, time_limit_s, budget, seed,
-//                                      task_only (0/1), grasps
+//   option NAME VALUE                  planner option: planner, wrench, objective (actions|makespan),
+//                                      time_limit_s, budget, seed, task_only (0/1), grasps
 //   run                                start the planner on the document (non-blocking)
 //   wait                               wait until the planner ends (frames keep drawing)
 //   expect-plan                        fail unless the last run gave a solved plan
