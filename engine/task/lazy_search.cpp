@@ -96,7 +96,9 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(
       std::reverse(path.begin(), path.end());
       return SearchStatus::kFound;
     }
-    if (static_cast<long long>(nodes_.size()) > node_budget) return SearchStatus::kNodeLimit;
+    if (static_cast<long long>(nodes_.size()) > node_budget || expansions_ > level_cap_) {
+      return SearchStatus::kNodeLimit;
+    }
     const SymState s = nodes_[index].s;
     Successors(s, m, res, successors);
     for (auto& [a, s2] : successors) {
@@ -164,6 +166,7 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
     int round_failures = 0;
     std::unordered_set<std::uint64_t> on_prefix;  // states the committed prefix visited
     while (!prefix.empty()) {
+      if (expansions_ > level_cap_) return SearchStatus::kExhausted;  // widen now
       on_prefix.clear();
       for (const Committed& p : prefix) on_prefix.insert(p.s.Hash());
       const int g0 = static_cast<int>(prefix.size()) - 1;

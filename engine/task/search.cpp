@@ -5,6 +5,7 @@
 #include "task/search.h"
 
 #include <chrono>
+#include <limits>
 
 #include "task/search_internal.h"
 
@@ -12,6 +13,11 @@ namespace wrap {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// Work budget of a resolution level that is not the last, in forward-search expansions: well
+// above what a solvable level takes (the median seed of every example needs under 20k for the
+// whole task), far below what an unsolvable one can take.
+constexpr long long kLevelExpansions = 50000;
 
 }  // namespace
 
@@ -193,10 +199,16 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   std::string abstract_failure;  // why the backward abstraction found no way, at the last level
   auto finish = [&]() {
     target_ = AssemblyTarget{};
+    level_cap_ = std::numeric_limits<long long>::max();
     search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
   };
   for (int level = 0; level < levels; ++level) {
     const Resolution res = ResolutionAt(level);
+    // A level that is not the last gets a work budget: a seed whose grasps at this resolution
+    // admit no plan would otherwise exhaust a large graph (100k-600k expansions: the tails of
+    // BENCHMARKS.md) before the next level, which usually solves it at once.
+    level_cap_ =
+        level + 1 < levels ? expansions_ + kLevelExpansions : std::numeric_limits<long long>::max();
     if (use_backward_) {
       const auto bwd_start = Clock::now();
       BuildBackward(m, res, s0);

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -342,7 +343,10 @@ class TaskSearch {
   std::vector<int> window_;      ///< FillWindow's steps (empty: FillFlat's whole task).
   int window_next_ = -1;         ///< The step after the window (-1: none).
   int fill_failures_ = 0;        ///< Edge validation failures in the current fill.
-  std::size_t rss0_ = 0;         ///< Resident memory when the search was made [bytes].
+  /// Expansions after which a resolution level that is not the last counts as exhausted (the
+  /// fill widens): no cap at the last level, which keeps the fill complete.
+  long long level_cap_ = std::numeric_limits<long long>::max();
+  std::size_t rss0_ = 0;  ///< Resident memory when the search was made [bytes].
   /// Steps of the window assembled in `s` (they are assembled in order).
   int WindowDone(const SymState& s) const;
   std::vector<Node> nodes_;
