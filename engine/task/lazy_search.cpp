@@ -117,8 +117,12 @@ TaskSearch::SearchStatus TaskSearch::BestFirst(
       const int hv = Heuristic(s2, m);
       if (g0 + g2 + hv > max_cost) continue;  // plan improvement: cannot beat the bound
       const int child = static_cast<int>(nodes_.size());
-      TaskClock clock = nodes_[index].clock;
-      Advance(s, a, clock);
+      // Only the makespan objective orders by the clock; the committed prefix keeps its own.
+      TaskClock clock;
+      if (by_makespan) {
+        clock = nodes_[index].clock;
+        Advance(s, a, clock);
+      }
       open.push(entry(g2 + weight_ * hv, g2, clock, child));
       nodes_.push_back({std::move(s2), g2, index, a, h2, std::move(clock)});
     }
@@ -260,7 +264,9 @@ TaskSearch::CandidateStatus TaskSearch::CommitCandidate(
     }
     actions.push_back(
         MakeAction(s, a, w->second, m.flat && !window_.empty() ? index + WindowDone(s) : index));
-    prefix.push_back({next, w->second.next, edge, nodes_[node_index].clock});
+    TaskClock clock = prefix.back().clock;
+    Advance(s, a, clock);
+    prefix.push_back({next, w->second.next, edge, std::move(clock)});
   }
   return CandidateStatus::kValid;
 }

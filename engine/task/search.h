@@ -162,7 +162,8 @@ class TaskSearch {
     int parent = -1;
     TaskAction a;
     std::uint64_t hash = 0;  ///< s.Hash(), computed once (the search's hot path).
-    TaskClock clock;         ///< The makespan estimate's clock after the path to s.
+    TaskClock clock;         ///< The makespan estimate's clock after the path to s (the
+                             ///< makespan objective only; empty otherwise).
   };
   enum class SearchStatus { kFound, kExhausted, kNodeLimit, kStopped, kOutOfMemory };
   /// Actions of a state with the states they lead to.
