@@ -150,7 +150,6 @@ bool Improve(TaskSearch& search, const std::vector<int>& order, const SymState& 
         candidate[j].actions.push_back(std::move(w.actions[x]));
         candidate[j].end = w.after[x].first;
         candidate[j].end_c = w.after[x].second;
-        candidate[j].end_clock = t;
       }
       bool ok = true;
       for (int j = i + n; j < K && ok; ++j) {
