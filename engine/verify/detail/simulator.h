@@ -26,6 +26,7 @@
 #include "sim/scene.h"
 #include "task/plan.h"
 #include "task/plan_state.h"
+#include "task/world.h"
 #include "verify/detail/collisions.h"
 #include "verify/simulate.h"
 #include "wrench/lp.h"
@@ -44,7 +45,7 @@ inline constexpr double kSupportReach_m = 0.001;
 inline constexpr size_t kMaxSupportPoints = 16;
 // RestingSupportSets: hull vertices this close to the table top carry a resting part, as the
 // planner's table supports count them (task/world.h TableContacts) [m] ...
-inline constexpr double kRestReach_m = 2e-3;
+inline constexpr double kRestReach_m = kTableContactReach_m;
 // ... of which those this close to the lowest touch it [m] ...
 inline constexpr double kTouchReach_m = 1e-4;
 // ... two closer than this are one [m] ...
