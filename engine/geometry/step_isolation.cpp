@@ -121,15 +121,16 @@ Result<StepAssembly> ImportInChild(const std::string& file,
                                     std::strerror(errno) + ")");
   }
   pid_t pid = -1;
+  int fork_errno = 0;
   {
     std::lock_guard lock(held);
     pid = ::fork();
+    fork_errno = errno;  // before the unlock can touch it
     if (pid == 0) {
       ::close(fds[0]);
       RunChild(fds[1], file, import);
     }
   }
-  const int fork_errno = errno;
   ::close(fds[1]);
   if (pid < 0) {
     ::close(fds[0]);
