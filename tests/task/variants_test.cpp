@@ -49,6 +49,12 @@ std::string WithoutTimes(Plan plan) {
 
 class VariantPlan : public ::testing::TestWithParam<std::string> {};
 
+// The seed each variant/project plans with: 3, except where that seed is one of the variant's
+// slow tails. The optimistic variant chooses the assembly's grasps first and searches for a way
+// to them; on the cross its time varies with the seed (seeds 0-5 on dev-2c, user CPU: 1.7, 10.8,
+// 13.9, 33.5, 47.9 s, and 60 s without a plan), and this test plans twice.
+int SeedFor(const std::string& param) { return param == "optimistic/cross" ? 0 : 3; }
+
 TEST_P(VariantPlan, IsSolvedValidAndDeterministic) {
   const auto [variant, project] = SplitParam(GetParam());
   const fs::path file = ProjectFile(project);
@@ -56,7 +62,8 @@ TEST_P(VariantPlan, IsSolvedValidAndDeterministic) {
   ASSERT_TRUE(lp.ok()) << project;
   TaskPlannerOptions options;
   options.planner = Variant(variant);
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 3, kNoTimeLimit, options);
+  const int seed = SeedFor(GetParam());
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, seed, kNoTimeLimit, options);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   const PlanStats& st = run.plan->stats;
   ASSERT_TRUE(st.solved) << GetParam() << ": " << st.failure;
@@ -82,7 +89,7 @@ TEST_P(VariantPlan, IsSolvedValidAndDeterministic) {
     }
   }
   // Same seed, same plan.
-  const PlanRun again = PlanAndValidate(*lp.project, lp.check, file, 3, kNoTimeLimit, options);
+  const PlanRun again = PlanAndValidate(*lp.project, lp.check, file, seed, kNoTimeLimit, options);
   ASSERT_TRUE(again.plan.has_value());
   EXPECT_EQ(WithoutTimes(*run.plan), WithoutTimes(*again.plan));
 }
@@ -225,7 +232,9 @@ TEST_P(OptimizedPlan, IsNoWorseAndValid) {
   TaskPlannerOptions options;
   options.planner = Variant(variant);
   options.optimize = true;
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 20.0, options);
+  // Plan improvement runs until the time limit; on dev-2c the stool's and the cross's last
+  // improvements come within 2 s of the start (seed 0), and 6 s leaves room on a loaded machine.
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, 6.0, options);
   ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
   const PlanStats& st = run.plan->stats;
   ASSERT_TRUE(st.solved) << st.failure;
