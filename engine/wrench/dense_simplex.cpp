@@ -15,6 +15,9 @@
 // column changing and a start without residual (x = 0): the artificials are crashed out of the
 // basis once (Gauss-Jordan, keeping B^-1), and each vertex starts phase 2 from that basis with
 // its column B^-1 w. That skips the ~m degenerate pivots a cold start spends per vertex.
+// With set_shared_phase1, a start with a residual (the joint "held, then mated" LP, whose holding
+// rows balance gravity) is treated alike: LoadBase runs phase 1 once with the varying column held
+// at 0, carrying B^-1 through its pivots, and every vertex starts phase 2 from that basis.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -30,8 +33,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Tableau entries smaller than this are not pivots. 1e-9 let degenerate phase-1 steps pivot on
 // entries of ~3e-8 in redundant rows, and the tableau lost every digit (tests/wrench/data).
 constexpr double kPivotTol = 1e-7;
-constexpr double kOptTol = 1e-9;    // Reduced costs within this of 0 are optimal.
-constexpr double kFeasTol = 1e-9;   // Harris' bound relaxation.
+constexpr double kOptTol = 1e-9;   // Reduced costs within this of 0 are optimal.
+constexpr double kFeasTol = 1e-9;  // Harris' bound relaxation.
 constexpr int kDegenerateRunForBland = 8;
 
 class DenseSimplex final : public LpBackend {
@@ -51,8 +54,14 @@ class DenseSimplex final : public LpBackend {
   LpStatus Iterate(bool phase1);
   // Reduced costs of the structural columns for the current basis and phase.
   void PriceAll(bool phase1, const std::vector<double>& cost);
-  // Pivots the tableau on row p, column q (and the reduced-cost row with it).
+  // Pivots the tableau on row p, column q (and the reduced-cost row with it; B^-1 too while
+  // track_binv_).
   void Pivot(int p, int q);
+  // LoadBase for a start with a residual: phase 1 once, the varying column held at 0; true when
+  // it found a feasible basis (then binv_ is its inverse).
+  bool SharedPhase1(int varying_column);
+  // Saves the current basis as the start of every SolveWithColumn.
+  void SaveStart();
   // Bounds of the basic variable of row r.
   void HeadBounds(int r, bool phase1, double& lb, double& ub) const {
     const int h = head_[r];
@@ -77,9 +86,12 @@ class DenseSimplex final : public LpBackend {
   std::vector<double> x_;    // Values of the nonbasic structurals.
   std::vector<double> lo_;   // Bounds of the structurals.
   std::vector<double> up_;
-  std::vector<double> d_;     // Reduced costs of the structurals (w entries, padding 0).
-  std::vector<double> zero_;  // Phase-1 structural costs (all zero).
-  double scale_ = 1.0;        // Largest |rhs|, at least 1: scales the phase-1 tolerance.
+  std::vector<double> d_;       // Reduced costs of the structurals (w entries, padding 0).
+  std::vector<double> zero_;    // Phase-1 structural costs (all zero).
+  double scale_ = 1.0;          // Largest |rhs|, at least 1: scales the phase-1 tolerance.
+  std::vector<double> sign_;    // Setup's sign of each row (its artificial starts at |residual|).
+  bool track_binv_ = false;     // Pivot updates binv_ as well (SharedPhase1).
+  int pending_iterations_ = 0;  // LoadBase's phase-1 pivots, reported by the next solve.
 
   // LoadBase's crash basis, the start of every SolveWithColumn.
   bool crashed_ = false;
@@ -119,9 +131,13 @@ void DenseSimplex::PriceAll(bool phase1, const std::vector<double>& cost) {
 
 void DenseSimplex::Pivot(int p, int q) {
   double* tp = &t_[static_cast<std::size_t>(p) * w_];
+  double* bp = track_binv_ ? &binv_[static_cast<std::size_t>(p) * m_] : nullptr;
   const double inv = 1.0 / tp[q];
   for (int j = 0; j < w_; ++j) tp[j] *= inv;
   tp[q] = 1.0;
+  if (bp) {
+    for (int k = 0; k < m_; ++k) bp[k] *= inv;
+  }
   for (int r = 0; r < m_; ++r) {
     if (r == p) continue;
     double* tr = &t_[static_cast<std::size_t>(r) * w_];
@@ -129,6 +145,10 @@ void DenseSimplex::Pivot(int p, int q) {
     if (f == 0.0) continue;
     Axpy4(tr, tp, f, w_);
     tr[q] = 0.0;
+    if (bp) {
+      double* br = &binv_[static_cast<std::size_t>(r) * m_];
+      for (int k = 0; k < m_; ++k) br[k] -= f * bp[k];
+    }
   }
   const double f = d_[q];
   if (f != 0.0) Axpy4(d_.data(), tp, f, w_);
@@ -281,6 +301,7 @@ LpStatus DenseSimplex::Setup(const LpProblem& problem, bool& need_phase1) {
   head_.resize(m_);
   xb_.resize(m_);
   t_.assign(static_cast<std::size_t>(m_) * w_, 0.0);
+  sign_.resize(m_);
 
   // Start: each variable at 0 clipped into its bounds; residuals carried by artificials.
   for (int j = 0; j < n_; ++j) x_[j] = lo_[j] > 0.0 ? lo_[j] : (up_[j] < 0.0 ? up_[j] : 0.0);
@@ -292,6 +313,7 @@ LpStatus DenseSimplex::Setup(const LpProblem& problem, bool& need_phase1) {
       if (x_[j] != 0.0) res -= problem.a[static_cast<std::size_t>(j) * m_ + r] * x_[j];
     }
     const double sign = res < 0.0 ? -1.0 : 1.0;
+    sign_[r] = sign;
     double* tr = &t_[static_cast<std::size_t>(r) * w_];
     for (int j = 0; j < n_; ++j) tr[j] = sign * problem.a[static_cast<std::size_t>(j) * m_ + r];
     head_[r] = n_ + r;
@@ -356,12 +378,17 @@ LpStatus DenseSimplex::Solve(const LpProblem& problem, LpSolution& solution) {
 void DenseSimplex::LoadBase(const LpProblem& problem, int varying_column) {
   LpBackend::LoadBase(problem, varying_column);
   crashed_ = false;
+  pending_iterations_ = 0;
   bool need_phase1 = true;
   if (varying_column < 0 || varying_column >= problem.cols) return;
   if (Setup(problem, need_phase1) != LpStatus::kOptimal) return;
-  // The crash needs a start without residual whatever the varying column holds: it must start
-  // at 0 and the other variables' start must satisfy A x = rhs.
-  if (need_phase1 || x_[varying_column] != 0.0) return;
+  // Either start serves every value of the varying column only when that column starts at 0.
+  if (x_[varying_column] != 0.0) return;
+  if (need_phase1) {
+    if (shared_phase1_ && SharedPhase1(varying_column)) SaveStart();
+    return;
+  }
+  // The crash needs a start without residual: the start must satisfy A x = rhs.
 
   // Crash: replace artificials by structural columns, widest bounds first (free, one-sided,
   // boxed; never fixed ones nor the varying column), each on the artificial row where it has the
@@ -409,12 +436,37 @@ void DenseSimplex::LoadBase(const LpProblem& problem, int varying_column) {
       row_of_[j] = p;
     }
   }
+  SaveStart();
+}
+
+void DenseSimplex::SaveStart() {
   t0_ = t_;
   head0_ = head_;
   row_of0_ = row_of_;
   xb0_ = xb_;
   x0_ = x_;
   crashed_ = true;
+}
+
+bool DenseSimplex::SharedPhase1(int varying_column) {
+  // The varying column held at 0: its tableau column zeroed, it never prices in nor blocks.
+  for (int r = 0; r < m_; ++r) t_[static_cast<std::size_t>(r) * w_ + varying_column] = 0.0;
+  // The artificial basis of the sign-scaled rows: B^-1 = diag(sign).
+  binv_.assign(static_cast<std::size_t>(m_) * m_, 0.0);
+  for (int r = 0; r < m_; ++r) binv_[static_cast<std::size_t>(r) * m_ + r] = sign_[r];
+  zero_.assign(n_, 0.0);
+  PriceAll(true, zero_);
+  track_binv_ = true;
+  const LpStatus status = Iterate(true);
+  track_binv_ = false;
+  pending_iterations_ = iterations_;
+  if (status != LpStatus::kOptimal) return false;
+  double infeasibility = 0.0;
+  for (int r = 0; r < m_; ++r) {
+    if (head_[r] >= n_) infeasibility += xb_[r];
+  }
+  // Infeasible whatever the varying column: the cold solves say so, each on its own.
+  return infeasibility <= 1e-8 * scale_;
 }
 
 LpStatus DenseSimplex::SolveWithColumn(const double* values, LpSolution& solution) {
@@ -424,8 +476,9 @@ LpStatus DenseSimplex::SolveWithColumn(const double* values, LpSolution& solutio
   row_of_ = row_of0_;
   xb_ = xb0_;
   x_ = x0_;
-  iterations_ = 0;
-  // The varying column in the crash basis: B^-1 values.
+  iterations_ = pending_iterations_;
+  pending_iterations_ = 0;
+  // The varying column in the start basis: B^-1 values.
   const int q = varying_column_;
   for (int r = 0; r < m_; ++r) {
     const double* br = &binv_[static_cast<std::size_t>(r) * m_];
