@@ -18,6 +18,11 @@
 // With set_shared_phase1, a start with a residual (the joint "held, then mated" LP, whose holding
 // rows balance gravity) is treated alike: LoadBase runs phase 1 once with the varying column held
 // at 0, carrying B^-1 through its pivots, and every vertex starts phase 2 from that basis.
+// When the varying column has a finite upper bound (the planner's load factor capped at 1) and the
+// last solve ended with it nonbasic at that bound, the next solve first tries that final basis:
+// with the column's variable fixed at its bound, a new column changes only the basic values
+// (x_B = x_B + (B^-1 w_old - B^-1 w_new) u); when they stay within bounds, that basis is optimal
+// for the new column too (its variable at its upper bound cannot rise) and no pivot is needed.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -62,6 +67,12 @@ class DenseSimplex final : public LpBackend {
   bool SharedPhase1(int varying_column);
   // Saves the current basis as the start of every SolveWithColumn.
   void SaveStart();
+  // The last solve's final basis with the varying column replaced by `col` (B^-1 of the new
+  // values), its variable at its upper bound: kOptimal into `solution` when the basic values
+  // stay within bounds, else kError and nothing changed.
+  LpStatus TryLastBasis(const std::vector<double>& col, LpSolution& solution);
+  // The solution of the current basis: x (basic values clipped into their bounds), objective.
+  void Extract(const std::vector<double>& cost, LpSolution& solution);
   // Bounds of the basic variable of row r.
   void HeadBounds(int r, bool phase1, double& lb, double& ub) const {
     const int h = head_[r];
@@ -95,7 +106,11 @@ class DenseSimplex final : public LpBackend {
 
   // LoadBase's crash basis, the start of every SolveWithColumn.
   bool crashed_ = false;
-  std::vector<double> binv_;  // B^-1 of the crash basis, row-major m x m.
+  std::vector<double> binv_;    // B^-1 of the current basis, row-major m x m (see track_binv_).
+  std::vector<double> binv0_;   // B^-1 of the start basis.
+  std::vector<double> col_;     // Scratch: B^-1 of the varying column's values.
+  bool last_at_bound_ = false;  // The last SolveWithColumn ended optimal with the varying
+                                // column nonbasic at its finite upper bound (binv_ current).
   std::vector<double> t0_;
   std::vector<int> head0_;
   std::vector<int> row_of0_;
@@ -350,6 +365,12 @@ LpStatus DenseSimplex::Run(bool need_phase1, const std::vector<double>& cost,
   solution.iterations = iterations_;
   if (status != LpStatus::kOptimal) return solution.status = status;
 
+  Extract(cost, solution);
+  return solution.status = LpStatus::kOptimal;
+}
+
+void DenseSimplex::Extract(const std::vector<double>& cost, LpSolution& solution) {
+  solution.x.resize(n_);
   for (int j = 0; j < n_; ++j) solution.x[j] = x_[j];
   for (int r = 0; r < m_; ++r) {
     const int h = head_[r];
@@ -360,10 +381,10 @@ LpStatus DenseSimplex::Run(bool need_phase1, const std::vector<double>& cost,
   double objective = 0.0;
   for (int j = 0; j < n_; ++j) objective += cost[j] * solution.x[j];
   solution.objective = objective;
-  return solution.status = LpStatus::kOptimal;
 }
 
 LpStatus DenseSimplex::Solve(const LpProblem& problem, LpSolution& solution) {
+  last_at_bound_ = false;  // The tableau is this problem's now.
   bool need_phase1 = false;
   const LpStatus status = Setup(problem, need_phase1);
   if (status != LpStatus::kOptimal) {
@@ -378,6 +399,7 @@ LpStatus DenseSimplex::Solve(const LpProblem& problem, LpSolution& solution) {
 void DenseSimplex::LoadBase(const LpProblem& problem, int varying_column) {
   LpBackend::LoadBase(problem, varying_column);
   crashed_ = false;
+  last_at_bound_ = false;
   pending_iterations_ = 0;
   bool need_phase1 = true;
   if (varying_column < 0 || varying_column >= problem.cols) return;
@@ -445,6 +467,7 @@ void DenseSimplex::SaveStart() {
   row_of0_ = row_of_;
   xb0_ = xb_;
   x0_ = x_;
+  binv0_ = binv_;
   crashed_ = true;
 }
 
@@ -469,8 +492,48 @@ bool DenseSimplex::SharedPhase1(int varying_column) {
   return infeasibility <= 1e-8 * scale_;
 }
 
+LpStatus DenseSimplex::TryLastBasis(const std::vector<double>& col, LpSolution& solution) {
+  const int q = varying_column_;
+  const double u = x_[q];
+  for (int r = 0; r < m_; ++r) {
+    const double v = xb_[r] + (t_[static_cast<std::size_t>(r) * w_ + q] - col[r]) * u;
+    double lb, ub;
+    HeadBounds(r, false, lb, ub);
+    if (v < lb - kFeasTol || v > ub + kFeasTol) return LpStatus::kError;
+  }
+  for (int r = 0; r < m_; ++r) {
+    double& tq = t_[static_cast<std::size_t>(r) * w_ + q];
+    xb_[r] += (tq - col[r]) * u;
+    tq = col[r];
+  }
+  solution.iterations = 0;
+  Extract(base_.cost, solution);
+  return solution.status = LpStatus::kOptimal;
+}
+
 LpStatus DenseSimplex::SolveWithColumn(const double* values, LpSolution& solution) {
   if (!crashed_) return LpBackend::SolveWithColumn(values, solution);
+  const int q = varying_column_;
+  // B^-1 values, for the last basis (when it may serve) or the start basis.
+  const bool try_last = last_at_bound_;
+  if (!try_last) binv_ = binv0_;
+  col_.resize(m_);
+  for (int r = 0; r < m_; ++r) {
+    const double* br = &binv_[static_cast<std::size_t>(r) * m_];
+    double v = 0.0;
+    for (int k = 0; k < m_; ++k) v += br[k] * values[k];
+    col_[r] = v;
+  }
+  if (try_last) {
+    if (TryLastBasis(col_, solution) == LpStatus::kOptimal) return LpStatus::kOptimal;
+    binv_ = binv0_;
+    for (int r = 0; r < m_; ++r) {
+      const double* br = &binv_[static_cast<std::size_t>(r) * m_];
+      double v = 0.0;
+      for (int k = 0; k < m_; ++k) v += br[k] * values[k];
+      col_[r] = v;
+    }
+  }
   t_ = t0_;
   head_ = head0_;
   row_of_ = row_of0_;
@@ -478,15 +541,14 @@ LpStatus DenseSimplex::SolveWithColumn(const double* values, LpSolution& solutio
   x_ = x0_;
   iterations_ = pending_iterations_;
   pending_iterations_ = 0;
-  // The varying column in the start basis: B^-1 values.
-  const int q = varying_column_;
-  for (int r = 0; r < m_; ++r) {
-    const double* br = &binv_[static_cast<std::size_t>(r) * m_];
-    double v = 0.0;
-    for (int k = 0; k < m_; ++k) v += br[k] * values[k];
-    t_[static_cast<std::size_t>(r) * w_ + q] = v;
-  }
-  return Run(false, base_.cost, solution);
+  for (int r = 0; r < m_; ++r) t_[static_cast<std::size_t>(r) * w_ + q] = col_[r];
+  // B^-1 follows the pivots only when the next solve may try this one's final basis.
+  track_binv_ = std::isfinite(up_[q]);
+  const LpStatus status = Run(false, base_.cost, solution);
+  track_binv_ = false;
+  last_at_bound_ =
+      status == LpStatus::kOptimal && std::isfinite(up_[q]) && row_of_[q] < 0 && x_[q] == up_[q];
+  return status;
 }
 
 }  // namespace

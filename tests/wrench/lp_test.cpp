@@ -284,6 +284,42 @@ TEST(DenseSimplex, SharedPhase1ByHand) {
   EXPECT_EQ(dense->SolveWithColumn(w, sol), LpStatus::kInfeasible);
 }
 
+// The same LP with s capped at 1 (the planner's fast path): a solve that ends with s at its cap
+// leaves a basis of x1, x2 alone, which the next column may reuse without a pivot when the basic
+// values stay within bounds: x1 - x2 = -s w1 and x1 + x2 = 3 give x1 = (3 - w1) / 2.
+TEST(DenseSimplex, CappedColumnReusesTheLastBasisByHand) {
+  LpProblem p;
+  p.Reset(2, 3);
+  p.a = {1, 1, 1, -1, 0, 0};
+  p.rhs = {3, 0};
+  p.upper = {2, 2, 1};
+  p.cost = {0, 0, -1};
+  std::unique_ptr<LpBackend> dense = MakeDenseSimplexBackend();
+  dense->set_shared_phase1(true);
+  dense->LoadBase(p, 2);
+  LpSolution sol;
+  const double w_first[] = {0, 0.5};  // s* = 2, capped: s = 1, x1 = 1.25, x2 = 1.75.
+  ASSERT_EQ(dense->SolveWithColumn(w_first, sol), LpStatus::kOptimal);
+  EXPECT_EQ(sol.x[2], 1.0);
+  EXPECT_NEAR(sol.x[0], 1.25, 1e-12);
+  EXPECT_GT(sol.iterations, 0);
+  const double w_reuse[] = {0, -0.5};  // x1 = 1.75, x2 = 1.25: the same basis, no pivot.
+  ASSERT_EQ(dense->SolveWithColumn(w_reuse, sol), LpStatus::kOptimal);
+  EXPECT_EQ(sol.iterations, 0);
+  EXPECT_EQ(sol.x[2], 1.0);
+  EXPECT_NEAR(sol.x[0], 1.75, 1e-12);
+  EXPECT_NEAR(sol.x[1], 1.25, 1e-12);
+  EXPECT_NEAR(sol.objective, -1.0, 1e-12);
+  const double w_fail[] = {0, 2};  // x1 = 0.5, x2 = 2.5 > 2: solved again, s* = 0.5.
+  ASSERT_EQ(dense->SolveWithColumn(w_fail, sol), LpStatus::kOptimal);
+  EXPECT_NEAR(sol.x[2], 0.5, 1e-12);
+  EXPECT_GT(sol.iterations, 0);
+  const double w_after[] = {0, 0.5};  // After a capped-below answer: solved from the start.
+  ASSERT_EQ(dense->SolveWithColumn(w_after, sol), LpStatus::kOptimal);
+  EXPECT_EQ(sol.x[2], 1.0);
+  EXPECT_NEAR(sol.x[0], 1.25, 1e-12);
+}
+
 // The joint LP's shape: a right-hand side that x = 0 does not meet, and a varying column. With
 // the shared phase 1 every solve starts phase 2 from one feasible basis; the objective must be
 // Clp's, and x feasible.
