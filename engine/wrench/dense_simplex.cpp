@@ -16,8 +16,9 @@
 // basis once (Gauss-Jordan, keeping B^-1), and each vertex starts phase 2 from that basis with
 // its column B^-1 w. That skips the ~m degenerate pivots a cold start spends per vertex.
 // With set_shared_phase1, a start with a residual (the joint "held, then mated" LP, whose holding
-// rows balance gravity) is treated alike: LoadBase runs phase 1 once with the varying column held
-// at 0, carrying B^-1 through its pivots, and every vertex starts phase 2 from that basis.
+// rows balance gravity) is treated alike: phase 1 runs once with the varying column held at 0,
+// carrying B^-1 through its pivots, and every later vertex starts phase 2 from that basis. The
+// first vertex is solved cold: many checks stop there, and carrying B^-1 costs.
 // When the varying column has a finite upper bound (the planner's load factor capped at 1) and the
 // last solve ended with it nonbasic at that bound, the next solve first tries that final basis:
 // with the column's variable fixed at its bound, a new column changes only the basic values
@@ -106,11 +107,13 @@ class DenseSimplex final : public LpBackend {
 
   // LoadBase's crash basis, the start of every SolveWithColumn.
   bool crashed_ = false;
-  std::vector<double> binv_;    // B^-1 of the current basis, row-major m x m (see track_binv_).
-  std::vector<double> binv0_;   // B^-1 of the start basis.
-  std::vector<double> col_;     // Scratch: B^-1 of the varying column's values.
-  bool last_at_bound_ = false;  // The last SolveWithColumn ended optimal with the varying
-                                // column nonbasic at its finite upper bound (binv_ current).
+  std::vector<double> binv_;        // B^-1 of the current basis, row-major m x m (see track_binv_).
+  std::vector<double> binv0_;       // B^-1 of the start basis.
+  std::vector<double> col_;         // Scratch: B^-1 of the varying column's values.
+  bool phase1_pending_ = false;     // LoadBase left the shared phase 1 for a second solve.
+  bool solved_since_load_ = false;  // A SolveWithColumn ran since LoadBase.
+  bool last_at_bound_ = false;      // The last SolveWithColumn ended optimal with the varying
+                                    // column nonbasic at its finite upper bound (binv_ current).
   std::vector<double> t0_;
   std::vector<int> head0_;
   std::vector<int> row_of0_;
@@ -400,14 +403,18 @@ void DenseSimplex::LoadBase(const LpProblem& problem, int varying_column) {
   LpBackend::LoadBase(problem, varying_column);
   crashed_ = false;
   last_at_bound_ = false;
+  phase1_pending_ = false;
+  solved_since_load_ = false;
   pending_iterations_ = 0;
   bool need_phase1 = true;
   if (varying_column < 0 || varying_column >= problem.cols) return;
   if (Setup(problem, need_phase1) != LpStatus::kOptimal) return;
   // Either start serves every value of the varying column only when that column starts at 0.
   if (x_[varying_column] != 0.0) return;
+  // The shared phase 1 waits for a second solve: a check that stops at its first vertex (a
+  // failure, or one vertex) then costs one cold solve, as without it.
   if (need_phase1) {
-    if (shared_phase1_ && SharedPhase1(varying_column)) SaveStart();
+    phase1_pending_ = shared_phase1_;
     return;
   }
   // The crash needs a start without residual: the start must satisfy A x = rhs.
@@ -512,7 +519,17 @@ LpStatus DenseSimplex::TryLastBasis(const std::vector<double>& col, LpSolution& 
 }
 
 LpStatus DenseSimplex::SolveWithColumn(const double* values, LpSolution& solution) {
-  if (!crashed_) return LpBackend::SolveWithColumn(values, solution);
+  if (!crashed_ && phase1_pending_ && solved_since_load_) {
+    phase1_pending_ = false;
+    bool need_phase1 = true;
+    if (Setup(base_, need_phase1) == LpStatus::kOptimal && SharedPhase1(varying_column_)) {
+      SaveStart();
+    }
+  }
+  if (!crashed_) {
+    solved_since_load_ = true;
+    return LpBackend::SolveWithColumn(values, solution);
+  }
   const int q = varying_column_;
   // B^-1 values, for the last basis (when it may serve) or the start basis.
   const bool try_last = last_at_bound_;
