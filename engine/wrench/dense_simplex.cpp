@@ -110,6 +110,7 @@ class DenseSimplex final : public LpBackend {
   std::vector<double> binv_;        // B^-1 of the current basis, row-major m x m (see track_binv_).
   std::vector<double> binv0_;       // B^-1 of the start basis.
   std::vector<double> col_;         // Scratch: B^-1 of the varying column's values.
+  bool shape_stale_ = false;        // Solve overwrote the sizes and bounds of the start.
   bool phase1_pending_ = false;     // LoadBase left the shared phase 1 for a second solve.
   bool solved_since_load_ = false;  // A SolveWithColumn ran since LoadBase.
   bool last_at_bound_ = false;      // The last SolveWithColumn ended optimal with the varying
@@ -387,7 +388,8 @@ void DenseSimplex::Extract(const std::vector<double>& cost, LpSolution& solution
 }
 
 LpStatus DenseSimplex::Solve(const LpProblem& problem, LpSolution& solution) {
-  last_at_bound_ = false;  // The tableau is this problem's now.
+  last_at_bound_ = false;  // The tableau, sizes and bounds are this problem's now.
+  shape_stale_ = crashed_;
   bool need_phase1 = false;
   const LpStatus status = Setup(problem, need_phase1);
   if (status != LpStatus::kOptimal) {
@@ -403,6 +405,7 @@ void DenseSimplex::LoadBase(const LpProblem& problem, int varying_column) {
   LpBackend::LoadBase(problem, varying_column);
   crashed_ = false;
   last_at_bound_ = false;
+  shape_stale_ = false;
   phase1_pending_ = false;
   solved_since_load_ = false;
   pending_iterations_ = 0;
@@ -529,6 +532,17 @@ LpStatus DenseSimplex::SolveWithColumn(const double* values, LpSolution& solutio
   if (!crashed_) {
     solved_since_load_ = true;
     return LpBackend::SolveWithColumn(values, solution);
+  }
+  if (shape_stale_) {
+    // Another problem was solved since LoadBase: its sizes and bounds back to the loaded one's.
+    m_ = base_.rows;
+    n_ = base_.cols;
+    w_ = (n_ + 3) & ~3;
+    lo_ = base_.lower;
+    up_ = base_.upper;
+    d_.resize(w_);
+    max_iterations_ = 50 * (m_ + n_) + 100;
+    shape_stale_ = false;
   }
   const int q = varying_column_;
   // B^-1 values, for the last basis (when it may serve) or the start basis.

@@ -324,6 +324,34 @@ TEST(DenseSimplex, CappedColumnReusesTheLastBasisByHand) {
   EXPECT_NEAR(sol.x[0], 1.25, 1e-12);
 }
 
+// The checker solves other problems between the vertices of one LoadBase (the zero-utilisation
+// variant after an unbounded vertex): the next SolveWithColumn must still solve the loaded one.
+// x1 + x2 + s w = 0, -1 <= x1 <= 1, x2 >= 0: w = -1 is unbounded (x2 = s), w = 1 gives s* = 1.
+TEST(DenseSimplex, SolveWithColumnAfterAnotherProblem) {
+  LpProblem p;
+  p.Reset(1, 3);
+  p.a = {1, 1, 0};
+  p.lower = {-1, 0, 0};
+  p.upper = {1, kInf, kInf};
+  p.cost = {0, 0, -1};
+  std::unique_ptr<LpBackend> dense = MakeDenseSimplexBackend();
+  dense->LoadBase(p, 2);
+  LpSolution sol;
+  const double w_unbounded[] = {-1};
+  EXPECT_EQ(dense->SolveWithColumn(w_unbounded, sol), LpStatus::kUnbounded);
+  LpProblem other = p;  // The zero-utilisation variant: finite bounds at 0, s = 1.
+  other.a[2] = -1;
+  other.lower = {0, 0, 1};
+  other.upper = {0, kInf, 1};
+  other.cost = {0, 0, 0};
+  ASSERT_EQ(dense->Solve(other, sol), LpStatus::kOptimal);
+  EXPECT_NEAR(sol.x[1], 1.0, 1e-12);
+  const double w_one[] = {1};
+  ASSERT_EQ(dense->SolveWithColumn(w_one, sol), LpStatus::kOptimal);
+  EXPECT_NEAR(sol.x[2], 1.0, 1e-12);
+  EXPECT_NEAR(sol.x[0], -1.0, 1e-12);
+}
+
 // The joint LP's shape: a right-hand side that x = 0 does not meet, and a varying column. With
 // the shared phase 1 every solve starts phase 2 from one feasible basis; the objective must be
 // Clp's, and x feasible.
