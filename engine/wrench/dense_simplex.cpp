@@ -15,6 +15,15 @@
 // column changing and a start without residual (x = 0): the artificials are crashed out of the
 // basis once (Gauss-Jordan, keeping B^-1), and each vertex starts phase 2 from that basis with
 // its column B^-1 w. That skips the ~m degenerate pivots a cold start spends per vertex.
+// With set_shared_phase1, a start with a residual (the joint "held, then mated" LP, whose holding
+// rows balance gravity) is treated alike: phase 1 runs once with the varying column held at 0,
+// carrying B^-1 through its pivots, and every later vertex starts phase 2 from that basis. The
+// first vertex is solved cold: many checks stop there, and carrying B^-1 costs.
+// When the varying column has a finite upper bound (the planner's load factor capped at 1) and the
+// last solve ended with it nonbasic at that bound, the next solve first tries that final basis:
+// with the column's variable fixed at its bound, a new column changes only the basic values
+// (x_B = x_B + (B^-1 w_old - B^-1 w_new) u); when they stay within bounds, that basis is optimal
+// for the new column too (its variable at its upper bound cannot rise) and no pivot is needed.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -30,8 +39,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Tableau entries smaller than this are not pivots. 1e-9 let degenerate phase-1 steps pivot on
 // entries of ~3e-8 in redundant rows, and the tableau lost every digit (tests/wrench/data).
 constexpr double kPivotTol = 1e-7;
-constexpr double kOptTol = 1e-9;    // Reduced costs within this of 0 are optimal.
-constexpr double kFeasTol = 1e-9;   // Harris' bound relaxation.
+constexpr double kOptTol = 1e-9;   // Reduced costs within this of 0 are optimal.
+constexpr double kFeasTol = 1e-9;  // Harris' bound relaxation.
 constexpr int kDegenerateRunForBland = 8;
 
 class DenseSimplex final : public LpBackend {
@@ -51,8 +60,20 @@ class DenseSimplex final : public LpBackend {
   LpStatus Iterate(bool phase1);
   // Reduced costs of the structural columns for the current basis and phase.
   void PriceAll(bool phase1, const std::vector<double>& cost);
-  // Pivots the tableau on row p, column q (and the reduced-cost row with it).
+  // Pivots the tableau on row p, column q (and the reduced-cost row with it; B^-1 too while
+  // track_binv_).
   void Pivot(int p, int q);
+  // LoadBase for a start with a residual: phase 1 once, the varying column held at 0; true when
+  // it found a feasible basis (then binv_ is its inverse).
+  bool SharedPhase1(int varying_column);
+  // Saves the current basis as the start of every SolveWithColumn.
+  void SaveStart();
+  // The last solve's final basis with the varying column replaced by `col` (B^-1 of the new
+  // values), its variable at its upper bound: kOptimal into `solution` when the basic values
+  // stay within bounds, else kError and nothing changed.
+  LpStatus TryLastBasis(const std::vector<double>& col, LpSolution& solution);
+  // The solution of the current basis: x (basic values clipped into their bounds), objective.
+  void Extract(const std::vector<double>& cost, LpSolution& solution);
   // Bounds of the basic variable of row r.
   void HeadBounds(int r, bool phase1, double& lb, double& ub) const {
     const int h = head_[r];
@@ -77,13 +98,23 @@ class DenseSimplex final : public LpBackend {
   std::vector<double> x_;    // Values of the nonbasic structurals.
   std::vector<double> lo_;   // Bounds of the structurals.
   std::vector<double> up_;
-  std::vector<double> d_;     // Reduced costs of the structurals (w entries, padding 0).
-  std::vector<double> zero_;  // Phase-1 structural costs (all zero).
-  double scale_ = 1.0;        // Largest |rhs|, at least 1: scales the phase-1 tolerance.
+  std::vector<double> d_;       // Reduced costs of the structurals (w entries, padding 0).
+  std::vector<double> zero_;    // Phase-1 structural costs (all zero).
+  double scale_ = 1.0;          // Largest |rhs|, at least 1: scales the phase-1 tolerance.
+  std::vector<double> sign_;    // Setup's sign of each row (its artificial starts at |residual|).
+  bool track_binv_ = false;     // Pivot updates binv_ as well (SharedPhase1).
+  int pending_iterations_ = 0;  // LoadBase's phase-1 pivots, reported by the next solve.
 
   // LoadBase's crash basis, the start of every SolveWithColumn.
   bool crashed_ = false;
-  std::vector<double> binv_;  // B^-1 of the crash basis, row-major m x m.
+  std::vector<double> binv_;        // B^-1 of the current basis, row-major m x m (see track_binv_).
+  std::vector<double> binv0_;       // B^-1 of the start basis.
+  std::vector<double> col_;         // Scratch: B^-1 of the varying column's values.
+  bool shape_stale_ = false;        // Solve overwrote the sizes and bounds of the start.
+  bool phase1_pending_ = false;     // LoadBase left the shared phase 1 for a second solve.
+  bool solved_since_load_ = false;  // A SolveWithColumn ran since LoadBase.
+  bool last_at_bound_ = false;      // The last SolveWithColumn ended optimal with the varying
+                                    // column nonbasic at its finite upper bound (binv_ current).
   std::vector<double> t0_;
   std::vector<int> head0_;
   std::vector<int> row_of0_;
@@ -119,9 +150,13 @@ void DenseSimplex::PriceAll(bool phase1, const std::vector<double>& cost) {
 
 void DenseSimplex::Pivot(int p, int q) {
   double* tp = &t_[static_cast<std::size_t>(p) * w_];
+  double* bp = track_binv_ ? &binv_[static_cast<std::size_t>(p) * m_] : nullptr;
   const double inv = 1.0 / tp[q];
   for (int j = 0; j < w_; ++j) tp[j] *= inv;
   tp[q] = 1.0;
+  if (bp) {
+    for (int k = 0; k < m_; ++k) bp[k] *= inv;
+  }
   for (int r = 0; r < m_; ++r) {
     if (r == p) continue;
     double* tr = &t_[static_cast<std::size_t>(r) * w_];
@@ -129,6 +164,10 @@ void DenseSimplex::Pivot(int p, int q) {
     if (f == 0.0) continue;
     Axpy4(tr, tp, f, w_);
     tr[q] = 0.0;
+    if (bp) {
+      double* br = &binv_[static_cast<std::size_t>(r) * m_];
+      for (int k = 0; k < m_; ++k) br[k] -= f * bp[k];
+    }
   }
   const double f = d_[q];
   if (f != 0.0) Axpy4(d_.data(), tp, f, w_);
@@ -281,6 +320,7 @@ LpStatus DenseSimplex::Setup(const LpProblem& problem, bool& need_phase1) {
   head_.resize(m_);
   xb_.resize(m_);
   t_.assign(static_cast<std::size_t>(m_) * w_, 0.0);
+  sign_.resize(m_);
 
   // Start: each variable at 0 clipped into its bounds; residuals carried by artificials.
   for (int j = 0; j < n_; ++j) x_[j] = lo_[j] > 0.0 ? lo_[j] : (up_[j] < 0.0 ? up_[j] : 0.0);
@@ -292,6 +332,7 @@ LpStatus DenseSimplex::Setup(const LpProblem& problem, bool& need_phase1) {
       if (x_[j] != 0.0) res -= problem.a[static_cast<std::size_t>(j) * m_ + r] * x_[j];
     }
     const double sign = res < 0.0 ? -1.0 : 1.0;
+    sign_[r] = sign;
     double* tr = &t_[static_cast<std::size_t>(r) * w_];
     for (int j = 0; j < n_; ++j) tr[j] = sign * problem.a[static_cast<std::size_t>(j) * m_ + r];
     head_[r] = n_ + r;
@@ -328,6 +369,12 @@ LpStatus DenseSimplex::Run(bool need_phase1, const std::vector<double>& cost,
   solution.iterations = iterations_;
   if (status != LpStatus::kOptimal) return solution.status = status;
 
+  Extract(cost, solution);
+  return solution.status = LpStatus::kOptimal;
+}
+
+void DenseSimplex::Extract(const std::vector<double>& cost, LpSolution& solution) {
+  solution.x.resize(n_);
   for (int j = 0; j < n_; ++j) solution.x[j] = x_[j];
   for (int r = 0; r < m_; ++r) {
     const int h = head_[r];
@@ -338,10 +385,11 @@ LpStatus DenseSimplex::Run(bool need_phase1, const std::vector<double>& cost,
   double objective = 0.0;
   for (int j = 0; j < n_; ++j) objective += cost[j] * solution.x[j];
   solution.objective = objective;
-  return solution.status = LpStatus::kOptimal;
 }
 
 LpStatus DenseSimplex::Solve(const LpProblem& problem, LpSolution& solution) {
+  last_at_bound_ = false;  // The tableau, sizes and bounds are this problem's now.
+  shape_stale_ = crashed_;
   bool need_phase1 = false;
   const LpStatus status = Setup(problem, need_phase1);
   if (status != LpStatus::kOptimal) {
@@ -356,12 +404,23 @@ LpStatus DenseSimplex::Solve(const LpProblem& problem, LpSolution& solution) {
 void DenseSimplex::LoadBase(const LpProblem& problem, int varying_column) {
   LpBackend::LoadBase(problem, varying_column);
   crashed_ = false;
+  last_at_bound_ = false;
+  shape_stale_ = false;
+  phase1_pending_ = false;
+  solved_since_load_ = false;
+  pending_iterations_ = 0;
   bool need_phase1 = true;
   if (varying_column < 0 || varying_column >= problem.cols) return;
   if (Setup(problem, need_phase1) != LpStatus::kOptimal) return;
-  // The crash needs a start without residual whatever the varying column holds: it must start
-  // at 0 and the other variables' start must satisfy A x = rhs.
-  if (need_phase1 || x_[varying_column] != 0.0) return;
+  // Either start serves every value of the varying column only when that column starts at 0.
+  if (x_[varying_column] != 0.0) return;
+  // The shared phase 1 waits for a second solve: a check that stops at its first vertex (a
+  // failure, or one vertex) then costs one cold solve, as without it.
+  if (need_phase1) {
+    phase1_pending_ = shared_phase1_;
+    return;
+  }
+  // The crash needs a start without residual: the start must satisfy A x = rhs.
 
   // Crash: replace artificials by structural columns, widest bounds first (free, one-sided,
   // boxed; never fixed ones nor the varying column), each on the artificial row where it has the
@@ -409,31 +468,118 @@ void DenseSimplex::LoadBase(const LpProblem& problem, int varying_column) {
       row_of_[j] = p;
     }
   }
+  SaveStart();
+}
+
+void DenseSimplex::SaveStart() {
   t0_ = t_;
   head0_ = head_;
   row_of0_ = row_of_;
   xb0_ = xb_;
   x0_ = x_;
+  binv0_ = binv_;
   crashed_ = true;
 }
 
+bool DenseSimplex::SharedPhase1(int varying_column) {
+  // The varying column held at 0: its tableau column zeroed, it never prices in nor blocks.
+  for (int r = 0; r < m_; ++r) t_[static_cast<std::size_t>(r) * w_ + varying_column] = 0.0;
+  // The artificial basis of the sign-scaled rows: B^-1 = diag(sign).
+  binv_.assign(static_cast<std::size_t>(m_) * m_, 0.0);
+  for (int r = 0; r < m_; ++r) binv_[static_cast<std::size_t>(r) * m_ + r] = sign_[r];
+  zero_.assign(n_, 0.0);
+  PriceAll(true, zero_);
+  track_binv_ = true;
+  const LpStatus status = Iterate(true);
+  track_binv_ = false;
+  pending_iterations_ = iterations_;
+  if (status != LpStatus::kOptimal) return false;
+  double infeasibility = 0.0;
+  for (int r = 0; r < m_; ++r) {
+    if (head_[r] >= n_) infeasibility += xb_[r];
+  }
+  // Infeasible whatever the varying column: the cold solves say so, each on its own.
+  return infeasibility <= 1e-8 * scale_;
+}
+
+LpStatus DenseSimplex::TryLastBasis(const std::vector<double>& col, LpSolution& solution) {
+  const int q = varying_column_;
+  const double u = x_[q];
+  for (int r = 0; r < m_; ++r) {
+    const double v = xb_[r] + (t_[static_cast<std::size_t>(r) * w_ + q] - col[r]) * u;
+    double lb, ub;
+    HeadBounds(r, false, lb, ub);
+    if (v < lb - kFeasTol || v > ub + kFeasTol) return LpStatus::kError;
+  }
+  for (int r = 0; r < m_; ++r) {
+    double& tq = t_[static_cast<std::size_t>(r) * w_ + q];
+    xb_[r] += (tq - col[r]) * u;
+    tq = col[r];
+  }
+  solution.iterations = 0;
+  Extract(base_.cost, solution);
+  return solution.status = LpStatus::kOptimal;
+}
+
 LpStatus DenseSimplex::SolveWithColumn(const double* values, LpSolution& solution) {
-  if (!crashed_) return LpBackend::SolveWithColumn(values, solution);
+  if (!crashed_ && phase1_pending_ && solved_since_load_) {
+    phase1_pending_ = false;
+    bool need_phase1 = true;
+    if (Setup(base_, need_phase1) == LpStatus::kOptimal && SharedPhase1(varying_column_)) {
+      SaveStart();
+    }
+  }
+  if (!crashed_) {
+    solved_since_load_ = true;
+    return LpBackend::SolveWithColumn(values, solution);
+  }
+  if (shape_stale_) {
+    // Another problem was solved since LoadBase: its sizes and bounds back to the loaded one's.
+    m_ = base_.rows;
+    n_ = base_.cols;
+    w_ = (n_ + 3) & ~3;
+    lo_ = base_.lower;
+    up_ = base_.upper;
+    d_.resize(w_);
+    max_iterations_ = 50 * (m_ + n_) + 100;
+    shape_stale_ = false;
+  }
+  const int q = varying_column_;
+  // B^-1 values, for the last basis (when it may serve) or the start basis.
+  const bool try_last = last_at_bound_;
+  if (!try_last) binv_ = binv0_;
+  col_.resize(m_);
+  for (int r = 0; r < m_; ++r) {
+    const double* br = &binv_[static_cast<std::size_t>(r) * m_];
+    double v = 0.0;
+    for (int k = 0; k < m_; ++k) v += br[k] * values[k];
+    col_[r] = v;
+  }
+  if (try_last) {
+    if (TryLastBasis(col_, solution) == LpStatus::kOptimal) return LpStatus::kOptimal;
+    binv_ = binv0_;
+    for (int r = 0; r < m_; ++r) {
+      const double* br = &binv_[static_cast<std::size_t>(r) * m_];
+      double v = 0.0;
+      for (int k = 0; k < m_; ++k) v += br[k] * values[k];
+      col_[r] = v;
+    }
+  }
   t_ = t0_;
   head_ = head0_;
   row_of_ = row_of0_;
   xb_ = xb0_;
   x_ = x0_;
-  iterations_ = 0;
-  // The varying column in the crash basis: B^-1 values.
-  const int q = varying_column_;
-  for (int r = 0; r < m_; ++r) {
-    const double* br = &binv_[static_cast<std::size_t>(r) * m_];
-    double v = 0.0;
-    for (int k = 0; k < m_; ++k) v += br[k] * values[k];
-    t_[static_cast<std::size_t>(r) * w_ + q] = v;
-  }
-  return Run(false, base_.cost, solution);
+  iterations_ = pending_iterations_;
+  pending_iterations_ = 0;
+  for (int r = 0; r < m_; ++r) t_[static_cast<std::size_t>(r) * w_ + q] = col_[r];
+  // B^-1 follows the pivots only when the next solve may try this one's final basis.
+  track_binv_ = std::isfinite(up_[q]);
+  const LpStatus status = Run(false, base_.cost, solution);
+  track_binv_ = false;
+  last_at_bound_ =
+      status == LpStatus::kOptimal && std::isfinite(up_[q]) && row_of_[q] < 0 && x_[q] == up_[q];
+  return status;
 }
 
 }  // namespace

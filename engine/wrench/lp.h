@@ -65,10 +65,16 @@ class LpBackend {
   /// Solves the loaded problem with column `varying_column` replaced by `values` (rows entries).
   /// The default copies the values in and calls Solve.
   virtual LpStatus SolveWithColumn(const double* values, LpSolution& solution);
+  /// Lets LoadBase solve once the phase 1 that every SolveWithColumn would repeat: when the
+  /// start leaves a residual (A x0 != rhs) that the varying column, starting at 0, does not
+  /// change, each SolveWithColumn then starts phase 2 from that feasible basis. The optimal
+  /// objective is the same; x may be another optimum. Off by default; the dense simplex uses it.
+  void set_shared_phase1(bool on) { shared_phase1_ = on; }
 
  protected:
-  LpProblem base_;          ///< The problem of LoadBase.
-  int varying_column_ = 0;  ///< Its varying column.
+  LpProblem base_;              ///< The problem of LoadBase.
+  int varying_column_ = 0;      ///< Its varying column.
+  bool shared_phase1_ = false;  ///< See set_shared_phase1.
 };
 
 /// Our dense bounded-variable primal simplex (two phases, Dantzig pricing, Harris ratio test,

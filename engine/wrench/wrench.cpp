@@ -100,6 +100,10 @@ struct WrenchChecker::Impl {
   int VertexAt(int i, int count) const {
     return options.first_failure_suffices ? (first_vertex + i) % count : i;
   }
+  // The load factor's upper bound: none, or 1 when only the verdict counts. Capped, a passing
+  // vertex stops at the first balance of its full load (often pivots before the largest load
+  // factor), the LP is never unbounded, and a failing vertex still gets its exact s* < 1.
+  double MaxLoadFactor() const { return options.first_failure_suffices ? 1.0 : kInf; }
   // After vertex v failed: true when the loop may stop there.
   bool StopAfterFailure(int v) {
     if (!options.first_failure_suffices) return false;
@@ -274,7 +278,7 @@ void WrenchChecker::Impl::BuildColumns(const StepConfiguration& config, WrenchGa
   }
   problem.cost[n] = -1.0;  // Maximise s.
   problem.lower[n] = 0.0;
-  problem.upper[n] = kInf;
+  problem.upper[n] = MaxLoadFactor();
 }
 
 Result<WrenchCheck> WrenchChecker::Impl::Finish(const StepConfiguration& explain_config,
@@ -480,7 +484,7 @@ int WrenchChecker::Impl::BuildJointProblem(const StepConfiguration& config, cons
   for (int i = 0; i < nb6; ++i) joint.rhs[i] = -w_grav[i];
   joint.cost[s_col] = -1.0;  // Maximise s.
   joint.lower[s_col] = 0.0;
-  joint.upper[s_col] = kInf;
+  joint.upper[s_col] = MaxLoadFactor();
   return s_col;
 }
 
@@ -608,6 +612,9 @@ WrenchChecker::WrenchChecker(const WrenchOptions& options) : impl_(std::make_uni
   impl_->options = options;
   impl_->lp =
       options.backend == WrenchLpBackend::kClp ? MakeClpBackend() : MakeDenseSimplexBackend();
+  // The planner's fast path: one phase 1 per joint LP instead of one per vertex (x may be
+  // another optimum; the load factor is the same). The full check keeps its exact solutions.
+  impl_->lp->set_shared_phase1(options.first_failure_suffices);
 }
 
 WrenchChecker::~WrenchChecker() = default;

@@ -175,6 +175,9 @@ struct WrenchOptions {
   /// but `utilisation`, `worst_vertex`, `failing_vertex_count` and the support loads cover only
   /// the vertices checked. Each check then starts at the vertex that failed last (the planner's
   /// questions come in runs of similar configurations). For searches that need a yes or no.
+  /// The load factor is then capped at 1 (a passing vertex stops at the first balance of its
+  /// full load: a passing check reports utilisation 1, not its least) and the vertices of a
+  /// "held, then mated" check share one phase 1; failing vertices keep their exact load factor.
   bool first_failure_suffices = false;
   /// Called with every question the checker computes (not those its cache answers): how the
   /// planner's real questions are recorded as test data (tests/wrench). Checkers of parallel

@@ -58,11 +58,15 @@ void Require(const Result<WrenchCheck>& r) {
   }
 }
 
-// One robust check, solved every time: 16 load-factor LPs of 12 rows.
-void BM_WrenchLpRobust(benchmark::State& state, WrenchLpBackend backend, int pyramid_edges) {
+// One robust check, solved every time: 16 load-factor LPs of 12 rows. `verdict_only`: the
+// planner's fast path (first_failure_suffices: the load factor capped at 1, a vertex's final
+// basis tried first for the next).
+void BM_WrenchLpRobust(benchmark::State& state, WrenchLpBackend backend, int pyramid_edges,
+                       bool verdict_only) {
   const StepConfiguration c = RobustStep(pyramid_edges);
   WrenchOptions options;
   options.backend = backend;
+  options.first_failure_suffices = verdict_only;
   WrenchChecker checker(options);
   Require(checker.Check(c));
   for (auto _ : state) {
@@ -71,9 +75,10 @@ void BM_WrenchLpRobust(benchmark::State& state, WrenchLpBackend backend, int pyr
   }
   state.counters["vertices"] = 16;
 }
-BENCHMARK_CAPTURE(BM_WrenchLpRobust, dense, WrenchLpBackend::kDense, 8);  // The default.
-BENCHMARK_CAPTURE(BM_WrenchLpRobust, dense_pyramid4, WrenchLpBackend::kDense, 4);
-BENCHMARK_CAPTURE(BM_WrenchLpRobust, clp, WrenchLpBackend::kClp, 8);
+BENCHMARK_CAPTURE(BM_WrenchLpRobust, dense, WrenchLpBackend::kDense, 8, false);  // The default.
+BENCHMARK_CAPTURE(BM_WrenchLpRobust, dense_pyramid4, WrenchLpBackend::kDense, 4, false);
+BENCHMARK_CAPTURE(BM_WrenchLpRobust, dense_verdict, WrenchLpBackend::kDense, 8, true);
+BENCHMARK_CAPTURE(BM_WrenchLpRobust, clp, WrenchLpBackend::kClp, 8, false);
 
 // A cached answer through the canonical key (encode, hash, compare, copy the answer out).
 void BM_WrenchLpCached(benchmark::State& state) {

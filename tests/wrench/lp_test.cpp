@@ -242,6 +242,177 @@ TEST(DenseSimplex, ColumnVariantsMatchClp) {
   EXPECT_GT(unbounded, 500);
 }
 
+// The shared phase 1 by hand: x1 + x2 = 3 (a residual at x = 0) and x1 - x2 + s w1 = 0 with
+// 0 <= x1, x2 <= 2. Then x1 - x2 = 2 x1 - 3 ranges over [-1, 1], so s* = 1 / |w1|, unbounded
+// when w1 = 0. The phase 1 (x1 + x2 = 3) is solved once, before the column is known.
+TEST(DenseSimplex, SharedPhase1ByHand) {
+  LpProblem p;
+  p.Reset(2, 3);
+  p.a = {1, 1, 1, -1, 0, 0};  // Columns x1, x2, s (its values per solve).
+  p.rhs = {3, 0};
+  p.upper = {2, 2, kInf};
+  p.cost = {0, 0, -1};
+  for (const bool shared : {false, true}) {
+    std::unique_ptr<LpBackend> dense = MakeDenseSimplexBackend();
+    dense->set_shared_phase1(shared);
+    dense->LoadBase(p, 2);
+    LpSolution sol;
+    const double w_half[] = {0, 2};
+    ASSERT_EQ(dense->SolveWithColumn(w_half, sol), LpStatus::kOptimal);
+    EXPECT_NEAR(sol.x[2], 0.5, 1e-12);
+    EXPECT_NEAR(sol.x[0] + sol.x[1], 3.0, 1e-12);
+    EXPECT_NEAR(sol.x[0] - sol.x[1], -1.0, 1e-12);
+    const double w_four[] = {0, -0.25};
+    ASSERT_EQ(dense->SolveWithColumn(w_four, sol), LpStatus::kOptimal);
+    EXPECT_NEAR(sol.x[2], 4.0, 1e-12);
+    EXPECT_NEAR(sol.x[0] - sol.x[1], 1.0, 1e-12);
+    const double w_none[] = {0, 0};
+    EXPECT_EQ(dense->SolveWithColumn(w_none, sol), LpStatus::kUnbounded);
+    // The same column on the first row too: x1 + x2 = 3 - s, x1 - x2 = -s, so x1 = (3 - 2 s) / 2
+    // >= 0 and x2 = 3 / 2 <= 2 hold up to s = 1.5.
+    const double w_both[] = {1, 1};
+    ASSERT_EQ(dense->SolveWithColumn(w_both, sol), LpStatus::kOptimal);
+    EXPECT_NEAR(sol.x[2], 1.5, 1e-12);
+  }
+  // x1 + x2 = 5 cannot be met within the bounds: infeasible whatever the column.
+  p.rhs = {5, 0};
+  std::unique_ptr<LpBackend> dense = MakeDenseSimplexBackend();
+  dense->set_shared_phase1(true);
+  dense->LoadBase(p, 2);
+  LpSolution sol;
+  const double w[] = {0, 1};
+  EXPECT_EQ(dense->SolveWithColumn(w, sol), LpStatus::kInfeasible);
+}
+
+// The same LP with s capped at 1 (the planner's fast path): a solve that ends with s at its cap
+// leaves a basis of x1, x2 alone, which the next column may reuse without a pivot when the basic
+// values stay within bounds: x1 - x2 = -s w1 and x1 + x2 = 3 give x1 = (3 - w1) / 2.
+TEST(DenseSimplex, CappedColumnReusesTheLastBasisByHand) {
+  LpProblem p;
+  p.Reset(2, 3);
+  p.a = {1, 1, 1, -1, 0, 0};
+  p.rhs = {3, 0};
+  p.upper = {2, 2, 1};
+  p.cost = {0, 0, -1};
+  std::unique_ptr<LpBackend> dense = MakeDenseSimplexBackend();
+  dense->set_shared_phase1(true);
+  dense->LoadBase(p, 2);
+  LpSolution sol;
+  // s* = 2, capped: s = 1, x1 = 1.25, x2 = 1.75. The first solve is cold, the second starts from
+  // the shared phase 1.
+  const double w_first[] = {0, 0.5};
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_EQ(dense->SolveWithColumn(w_first, sol), LpStatus::kOptimal);
+    EXPECT_EQ(sol.x[2], 1.0);
+    EXPECT_NEAR(sol.x[0], 1.25, 1e-12);
+    EXPECT_GT(sol.iterations, 0);
+  }
+  const double w_reuse[] = {0, -0.5};  // x1 = 1.75, x2 = 1.25: the same basis, no pivot.
+  ASSERT_EQ(dense->SolveWithColumn(w_reuse, sol), LpStatus::kOptimal);
+  EXPECT_EQ(sol.iterations, 0);
+  EXPECT_EQ(sol.x[2], 1.0);
+  EXPECT_NEAR(sol.x[0], 1.75, 1e-12);
+  EXPECT_NEAR(sol.x[1], 1.25, 1e-12);
+  EXPECT_NEAR(sol.objective, -1.0, 1e-12);
+  const double w_fail[] = {0, 2};  // x1 = 0.5, x2 = 2.5 > 2: solved again, s* = 0.5.
+  ASSERT_EQ(dense->SolveWithColumn(w_fail, sol), LpStatus::kOptimal);
+  EXPECT_NEAR(sol.x[2], 0.5, 1e-12);
+  EXPECT_GT(sol.iterations, 0);
+  const double w_after[] = {0, 0.5};  // After a capped-below answer: solved from the start.
+  ASSERT_EQ(dense->SolveWithColumn(w_after, sol), LpStatus::kOptimal);
+  EXPECT_EQ(sol.x[2], 1.0);
+  EXPECT_NEAR(sol.x[0], 1.25, 1e-12);
+}
+
+// The checker solves other problems between the vertices of one LoadBase (the zero-utilisation
+// variant after an unbounded vertex): the next SolveWithColumn must still solve the loaded one.
+// x1 + x2 + s w = 0, -1 <= x1 <= 1, x2 >= 0: w = -1 is unbounded (x2 = s), w = 1 gives s* = 1.
+TEST(DenseSimplex, SolveWithColumnAfterAnotherProblem) {
+  LpProblem p;
+  p.Reset(1, 3);
+  p.a = {1, 1, 0};
+  p.lower = {-1, 0, 0};
+  p.upper = {1, kInf, kInf};
+  p.cost = {0, 0, -1};
+  std::unique_ptr<LpBackend> dense = MakeDenseSimplexBackend();
+  dense->LoadBase(p, 2);
+  LpSolution sol;
+  const double w_unbounded[] = {-1};
+  EXPECT_EQ(dense->SolveWithColumn(w_unbounded, sol), LpStatus::kUnbounded);
+  LpProblem other = p;  // The zero-utilisation variant: finite bounds at 0, s = 1.
+  other.a[2] = -1;
+  other.lower = {0, 0, 1};
+  other.upper = {0, kInf, 1};
+  other.cost = {0, 0, 0};
+  ASSERT_EQ(dense->Solve(other, sol), LpStatus::kOptimal);
+  EXPECT_NEAR(sol.x[1], 1.0, 1e-12);
+  const double w_one[] = {1};
+  ASSERT_EQ(dense->SolveWithColumn(w_one, sol), LpStatus::kOptimal);
+  EXPECT_NEAR(sol.x[2], 1.0, 1e-12);
+  EXPECT_NEAR(sol.x[0], -1.0, 1e-12);
+}
+
+// The joint LP's shape: a right-hand side that x = 0 does not meet, and a varying column. With
+// the shared phase 1 every solve starts phase 2 from one feasible basis; the objective must be
+// Clp's, and x feasible.
+TEST(DenseSimplex, SharedPhase1VariantsMatchClp) {
+  std::mt19937_64 rng(123);
+  std::unique_ptr<LpBackend> dense = MakeDenseSimplexBackend();
+  dense->set_shared_phase1(true);
+  std::unique_ptr<LpBackend> clp = MakeClpBackend();
+  LpSolution a, b;
+  int optimal = 0, unbounded = 0, infeasible = 0, capped = 0;
+  for (int trial = 0; trial < 1000; ++trial) {
+    LpProblem p;
+    const int m = 6 * UniformInt(rng, 1, 3);
+    const int n = UniformInt(rng, 1, 40);
+    p.Reset(m, n + 1);
+    std::vector<double> x0(n);
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < m; ++i) p.a[j * m + i] = Uniform(rng, 0, 1) < 0.5 ? 0.0 : Normal(rng);
+      const double r = Uniform(rng, 0, 1);
+      p.lower[j] = r < 0.3 ? 0.0 : (r < 0.4 ? -kInf : -Uniform(rng, 0, 5));
+      p.upper[j] = r < 0.3 ? kInf : (r < 0.5 ? kInf : (r < 0.6 ? 0.0 : Uniform(rng, 0, 5)));
+      const double lo = std::max(p.lower[j], -3.0), hi = std::min(p.upper[j], 3.0);
+      x0[j] = Uniform(rng, lo, hi);
+    }
+    // Mostly a right-hand side some x0 within the bounds meets; one in ten at random.
+    const bool reachable = Uniform(rng, 0, 1) < 0.9;
+    for (int i = 0; i < m; ++i) {
+      double v = 0.0;
+      for (int j = 0; j < n; ++j) v += p.a[j * m + i] * x0[j];
+      p.rhs[i] = reachable ? v : 5.0 * Normal(rng);
+    }
+    p.cost[n] = -1.0;
+    // Half the trials cap the load factor at 1, as the planner's fast path does.
+    p.upper[n] = trial % 2 == 0 ? kInf : 1.0;
+    dense->LoadBase(p, n);
+    for (int v = 0; v < 8; ++v) {
+      std::vector<double> w(m);
+      for (double& x : w) x = 10.0 * Normal(rng);
+      std::copy(w.begin(), w.end(), p.column(n));
+      const LpStatus sa = dense->SolveWithColumn(w.data(), a);
+      const LpStatus sb = clp->Solve(p, b);
+      ASSERT_EQ(sa, sb) << "trial " << trial << " vertex " << v;
+      if (sa == LpStatus::kOptimal) {
+        ++optimal;
+        EXPECT_NEAR(a.objective, b.objective, 1e-6 * (1.0 + std::abs(b.objective)))
+            << "trial " << trial << " vertex " << v;
+        EXPECT_LT(Violation(p, a.x), 1e-7);
+        if (p.upper[n] == 1.0 && a.x[n] == 1.0) ++capped;
+      } else if (sa == LpStatus::kUnbounded) {
+        ++unbounded;
+      } else {
+        ++infeasible;
+      }
+    }
+  }
+  EXPECT_GT(optimal, 2000);
+  EXPECT_GT(unbounded, 500);
+  EXPECT_GT(infeasible, 100);
+  EXPECT_GT(capped, 500);
+}
+
 Mat3 RandomRotation(std::mt19937_64& rng) {
   Eigen::Quaterniond q(Normal(rng), Normal(rng), Normal(rng), Normal(rng));
   q.normalize();
