@@ -33,7 +33,8 @@ StepConfiguration BuildWrenchConfig(const TaskWorld& world, const TaskTables& ta
       const TaskRobot& r = world.robots[robot];
       const Iso3 X_WG = o.X_WA * world.X_AP[g.part] * g.X_PG;
       config.grippers.push_back(
-          MakeGripper(r.name, body_of[g.part], X_WG, r.end_effector.kind, r.limits));
+          MakeGripper(r.name, body_of[g.part], X_WG, r.end_effector.kind,
+                      GraspLimits(r.limits, g.torque_scale)));
     }
     if (o.resting) {
       for (auto& [part, points] : TableContacts(world, o.node, o.X_WA)) {

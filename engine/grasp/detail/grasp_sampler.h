@@ -45,6 +45,16 @@ std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
                                             GripperCollision& world, std::mt19937_64& rng,
                                             const RunContext& ctx);
 
+/// Reduced two-finger sampling (partial-pad and fingertip grasps, grasp.h GraspType): as
+/// SampleTwoFinger, on a finer pad grid, keeping only grasps whose smaller pad contact lies
+/// between options.min_reduced_contact_m2 and options.min_pad_contact_m2, with the pads centred
+/// on the contacts (partial-pad) or pulled back so that their tips reach just past them
+/// (fingertip); each with its torque scale (GraspTorqueScale).
+std::vector<GraspCandidate> SampleTwoFingerReduced(const SamplerInput& in,
+                                                   const TwoFingerGraspOptions& options,
+                                                   GripperCollision& world, std::mt19937_64& rng,
+                                                   const RunContext& ctx);
+
 /// Vacuum sampling: a surface point whose cup disc rests on a flat patch (every test point of
 /// the disc on the tangent plane within the tolerance, normals aligned), cup axis along the
 /// normal, and a rotation about it for which the gripper, backed off by the standoff, does not
