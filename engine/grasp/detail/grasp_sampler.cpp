@@ -154,6 +154,14 @@ struct TwoFingerPass {
   double max_area = std::numeric_limits<double>::infinity();  // the smaller pad's must be below
   std::array<PadDepth, 3> depths{};
   int num_depths = 0;
+  // Keep every approach direction that works for a contact pair (one depth each), not only the
+  // first: a small feature (a collar under a flange) may be held from one side only, and the
+  // selection picks the approaches that clear the mating partner.
+  bool every_approach = false;
+  // Try first the approach straight down in the assembly's frame (where it has one about the
+  // closing line): a fingertip grasp keeps the gripper above what the part stands in, and a
+  // tilted one dips the fingers' corners.
+  bool from_above_first = false;
 };
 
 std::vector<GraspCandidate> SampleTwoFingerPass(const SamplerInput& in,
@@ -204,20 +212,25 @@ std::vector<GraspCandidate> SampleTwoFingerPass(const SamplerInput& in,
     const Vec3 m = 0.5 * (p + q);
 
     const double phase0 = 2.0 * std::numbers::pi * Uniform01(rng);
-    const int approaches = std::clamp(options.approach_samples, 1, kMaxApproaches);
+    const int approaches = std::clamp(options.approach_samples, 1, kMaxApproaches - 1);
     // A pad rectangle is symmetric under a half turn: approaches pi apart share pad tests.
     const int period = approaches % 2 == 0 ? approaches / 2 : approaches;
     std::array<std::array<PadPatch, kMaxApproaches>, 3> pad_p, pad_q;
     for (auto* pads : {&pad_p, &pad_q}) {
       for (auto& row : *pads) row.fill(PadPatch{std::numeric_limits<double>::quiet_NaN()});
     }
+    // Down in A, in P, across the closing line (k = -1 below); none when nearly along it.
+    const Vec3 down_P = in.X_AP.linear().transpose() * -Vec3::UnitZ();
+    const Vec3 down_across = down_P - down_P.dot(d) * d;
+    const int first = pass.from_above_first && down_across.norm() > 0.5 ? -1 : 0;
     bool found = false;
-    for (int k = 0; k < approaches && !found; ++k) {
-      const Vec3 a =
-          Tilted(d, 0.5 * std::numbers::pi, phase0 + 2.0 * std::numbers::pi * k / approaches);
+    for (int k = first; k < approaches && (!found || pass.every_approach); ++k) {
+      const Vec3 a = k < 0 ? Vec3(down_across.normalized())
+                           : Tilted(d, 0.5 * std::numbers::pi,
+                                    phase0 + 2.0 * std::numbers::pi * k / approaches);
       const Vec3 e_w = d.cross(a);
       // Pads: the one at -d pushes p along +d, the one at +d pushes q along -d.
-      const int key = k % period;
+      const int key = k < 0 ? kMaxApproaches - 1 : k % period;
       for (int depth = 0; depth < pass.num_depths; ++depth) {
         const double shift = pass.depths[depth].shift;
         PadPatch& patch_p = pad_p[depth][key];
@@ -259,6 +272,7 @@ std::vector<GraspCandidate> SampleTwoFingerPass(const SamplerInput& in,
         c.pad_fraction = pad_area > 0.0 ? std::min(1.0, c.grasp.contact_area_m2 / pad_area) : 0.0;
         out.push_back(std::move(c));
         found = true;  // one approach per contact pair keeps the candidates spread
+        if (pass.every_approach) break;  // the next approach, not the next depth
       }
     }
   }
@@ -304,6 +318,8 @@ std::vector<GraspCandidate> SampleTwoFingerReduced(const SamplerInput& in,
   pass.depths[pass.num_depths++] = {std::max(0.0, half - 0.003), GraspType::kFingertip};
   pass.depths[pass.num_depths++] = {std::max(0.0, half - std::max(0.0, options.fingertip_reach_m)),
                                     GraspType::kFingertip};
+  pass.every_approach = true;
+  pass.from_above_first = true;
   return SampleTwoFingerPass(in, options, pass, world, rng, ctx);
 }
 
