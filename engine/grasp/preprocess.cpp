@@ -244,9 +244,9 @@ Result<SampledCandidates> SampleCandidates(const Project& project, const Project
     // Reduced grasps from a generator of their own: the full-pad candidates stay as they were.
     std::mt19937_64 reduced_rng(
         MixSeed(out.seed, 0x9e3779b97f4a7c15ULL ^ (static_cast<std::uint64_t>(task) + 1)));
-    // Twice the pool: the reduced pass keeps several approach directions per contact pair.
+    // A larger pool: the features only reduced grasps hold are small (a collar, a button).
     detail::SamplerInput reduced_in = in;
-    reduced_in.wanted = 2 * pool;
+    reduced_in.wanted = 4 * pool;
     std::vector<detail::GraspCandidate> reduced =
         detail::SampleTwoFingerReduced(reduced_in, options.two_finger, local, reduced_rng, ctx);
     mine.insert(mine.end(), std::make_move_iterator(reduced.begin()),

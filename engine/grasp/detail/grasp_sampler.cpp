@@ -145,19 +145,16 @@ namespace {
 struct PadDepth {
   double shift = 0.0;
   GraspType type = GraspType::kFullPad;
+  // The smaller pad's contact must be below this [m^2] (a partial-pad grasp: less than full).
+  double max_area = std::numeric_limits<double>::infinity();
 };
 
 // What distinguishes the full-pad pass from the reduced one.
 struct TwoFingerPass {
   int rays_w = 4, rays_l = 6;
   double min_area = 0.0;  // least contact on each pad [m^2]
-  double max_area = std::numeric_limits<double>::infinity();  // the smaller pad's must be below
   std::array<PadDepth, 3> depths{};
   int num_depths = 0;
-  // Keep every approach direction that works for a contact pair (one depth each), not only the
-  // first: a small feature (a collar under a flange) may be held from one side only, and the
-  // selection picks the approaches that clear the mating partner.
-  bool every_approach = false;
   // Try first the approach straight down in the assembly's frame (where it has one about the
   // closing line): a fingertip grasp keeps the gripper above what the part stands in, and a
   // tilted one dips the fingers' corners.
@@ -224,7 +221,7 @@ std::vector<GraspCandidate> SampleTwoFingerPass(const SamplerInput& in,
     const Vec3 down_across = down_P - down_P.dot(d) * d;
     const int first = pass.from_above_first && down_across.norm() > 0.5 ? -1 : 0;
     bool found = false;
-    for (int k = first; k < approaches && (!found || pass.every_approach); ++k) {
+    for (int k = first; k < approaches && !found; ++k) {
       const Vec3 a = k < 0 ? Vec3(down_across.normalized())
                            : Tilted(d, 0.5 * std::numbers::pi,
                                     phase0 + 2.0 * std::numbers::pi * k / approaches);
@@ -246,7 +243,7 @@ std::vector<GraspCandidate> SampleTwoFingerPass(const SamplerInput& in,
         }
         if (patch_q.area_m2 < pass.min_area) continue;
         const PadPatch patch = Smaller(patch_p, patch_q);
-        if (patch.area_m2 >= pass.max_area) continue;
+        if (patch.area_m2 >= pass.depths[depth].max_area) continue;
         Iso3 X_PG = Iso3::Identity();
         X_PG.linear() = FrameFromAxes(d, a, c_T, a_T);
         X_PG.translation() = m - X_PG.linear() * pad_T - shift * a;
@@ -272,7 +269,6 @@ std::vector<GraspCandidate> SampleTwoFingerPass(const SamplerInput& in,
         c.pad_fraction = pad_area > 0.0 ? std::min(1.0, c.grasp.contact_area_m2 / pad_area) : 0.0;
         out.push_back(std::move(c));
         found = true;  // one approach per contact pair keeps the candidates spread
-        if (pass.every_approach) break;  // the next approach, not the next depth
       }
     }
   }
@@ -310,15 +306,16 @@ std::vector<GraspCandidate> SampleTwoFingerReduced(const SamplerInput& in,
   pass.rays_w = options.reduced_rays_width;
   pass.rays_l = options.reduced_rays_length;
   pass.min_area = options.min_reduced_contact_m2;
-  pass.max_area = options.min_pad_contact_m2;  // at or above it: a full-pad grasp
-  // Pads centred on the contacts (partial-pad), then the tips 3 mm past the contacts (the
-  // full-pad pass's shallow depth), then `fingertip_reach_m` past them (fingertip).
+  // Pads centred on the contacts touching less than a full pad (partial-pad), then the tips
+  // 3 mm past the contacts (the full-pad pass's shallow depth) touching less than a full pad,
+  // then the tips `fingertip_reach_m` past them with any contact (fingertip; the full-pad pass
+  // does not reach this far forward). Their limits come from the patch either way.
   const double half = 0.5 * ee.pad_length_m;
-  pass.depths[pass.num_depths++] = {0.0, GraspType::kPartialPad};
-  pass.depths[pass.num_depths++] = {std::max(0.0, half - 0.003), GraspType::kFingertip};
+  pass.depths[pass.num_depths++] = {0.0, GraspType::kPartialPad, options.min_pad_contact_m2};
+  pass.depths[pass.num_depths++] = {std::max(0.0, half - 0.003), GraspType::kFingertip,
+                                    options.min_pad_contact_m2};
   pass.depths[pass.num_depths++] = {std::max(0.0, half - std::max(0.0, options.fingertip_reach_m)),
                                     GraspType::kFingertip};
-  pass.every_approach = true;
   pass.from_above_first = true;
   return SampleTwoFingerPass(in, options, pass, world, rng, ctx);
 }

@@ -46,10 +46,12 @@ std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
                                             const RunContext& ctx);
 
 /// Reduced two-finger sampling (partial-pad and fingertip grasps, grasp.h GraspType): as
-/// SampleTwoFinger, on a finer pad grid, keeping only grasps whose smaller pad contact lies
-/// between options.min_reduced_contact_m2 and options.min_pad_contact_m2, with the pads centred
-/// on the contacts (partial-pad) or pulled back so that their tips reach just past them
-/// (fingertip); each with its torque scale (GraspTorqueScale).
+/// SampleTwoFinger, on a finer pad grid, trying first the approach straight down in the
+/// assembly's frame, with the pads centred on the contacts touching less than
+/// options.min_pad_contact_m2 (partial-pad), pulled back so that their tips stand 3 mm past the
+/// contacts touching less than that, or pulled back to options.fingertip_reach_m past them with
+/// any contact (fingertip); at least options.min_reduced_contact_m2 on each pad. Each grasp has
+/// its torque scale (GraspTorqueScale).
 std::vector<GraspCandidate> SampleTwoFingerReduced(const SamplerInput& in,
                                                    const TwoFingerGraspOptions& options,
                                                    GripperCollision& world, std::mt19937_64& rng,
