@@ -83,6 +83,9 @@ struct GraspSet {
   int candidates = 0;  ///< Collision-free candidates the set was selected from (statistics).
   /// Of them, per GraspType (index: the enum's value).
   std::array<int, kGraspTypes> candidates_by_type = {0, 0, 0};
+  /// Of them, per GraspType, those whose gripper clears the mating partner at the mating pose
+  /// (the assembly grasps the set's tiers put first).
+  std::array<int, kGraspTypes> assembly_candidates_by_type = {0, 0, 0};
 };
 
 /// Options of the two-finger antipodal sampler.

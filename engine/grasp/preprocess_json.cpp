@@ -116,6 +116,7 @@ std::string PreprocessedToJson(const Project& project, const Preprocessed& resul
     for (const StablePlacement& s : sub.placements) placements.push_back(PlacementJson(s));
     json grasps = json::array();
     json counts = json::object(), by_type = json::object(), candidates = json::object();
+    json assembly = json::object();
     for (const GraspSet& set : sub.grasp_sets) {
       counts[set.end_effector] = set.grasps.size();
       by_type[set.end_effector] = ByType(set.grasps, [](const Grasp& g) { return g.type; });
@@ -124,6 +125,11 @@ std::string PreprocessedToJson(const Project& project, const Preprocessed& resul
         c[std::string(ToString(static_cast<GraspType>(t)))] = set.candidates_by_type[t];
       }
       candidates[set.end_effector] = c;
+      json a = json::object();
+      for (int t = 0; t < kGraspTypes; ++t) {
+        a[std::string(ToString(static_cast<GraspType>(t)))] = set.assembly_candidates_by_type[t];
+      }
+      assembly[set.end_effector] = a;
       for (const Grasp& g : set.grasps) grasps.push_back(GraspJson(project, sub, g));
     }
     subs.push_back(json{{"name", sub.name},
@@ -138,6 +144,7 @@ std::string PreprocessedToJson(const Project& project, const Preprocessed& resul
                         {"grasp_counts", counts},
                         {"grasp_counts_by_type", by_type},
                         {"candidates_by_type", candidates},
+                        {"assembly_candidates_by_type", assembly},
                         {"grasps", grasps}});
   }
   doc["subassemblies"] = subs;

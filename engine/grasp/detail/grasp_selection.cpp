@@ -214,7 +214,11 @@ GraspSet SpreadGrasps(const ScoredCandidates& scored, const EndEffector& ee, int
   set.end_effector = ee.name;
   set.kind = ee.kind;
   set.candidates = static_cast<int>(scored.kept.size());
-  for (const GraspCandidate* c : scored.kept) ++set.candidates_by_type[static_cast<int>(c->grasp.type)];
+  for (size_t i = 0; i < scored.kept.size(); ++i) {
+    const int type = static_cast<int>(scored.kept[i]->grasp.type);
+    ++set.candidates_by_type[type];
+    if (scored.clear_of_partner[i]) ++set.assembly_candidates_by_type[type];
+  }
   for (int i : order) {
     Grasp g = scored.kept[i]->grasp;
     g.quality = scored.quality[i];
