@@ -47,9 +47,9 @@ struct Grasp {
 /// The contact patch of a reduced two-finger grasp, as the sampler measured it on the smaller
 /// of the two pads.
 struct PadPatch {
-  double area_m2 = 0.0;    ///< Touching area [m^2].
-  double width_m = 0.0;    ///< Extent across the pad's width (normal to the approach) [m].
-  double length_m = 0.0;   ///< Extent along the pad's length (along the approach) [m].
+  double area_m2 = 0.0;   ///< Touching area [m^2].
+  double width_m = 0.0;   ///< Extent across the pad's width (normal to the approach) [m].
+  double length_m = 0.0;  ///< Extent along the pad's length (along the approach) [m].
 };
 
 /// The physical model of a reduced grasp's limits (docs/algorithms.md "Grasp types"), as

@@ -25,8 +25,8 @@ Vec3 GraspTorqueScale(const PadPatch& patch, double full_area_m2, const Vec3& cl
   if (!(full_area_m2 > 0.0)) return Vec3::Ones();
   // The reference: a square patch of the full-pad area carries the adopted box.
   const double side = std::sqrt(full_area_m2);
-  const double radius = std::clamp(std::sqrt(std::max(0.0, patch.area_m2) / full_area_m2), 0.0,
-                                   1.0);
+  const double radius =
+      std::clamp(std::sqrt(std::max(0.0, patch.area_m2) / full_area_m2), 0.0, 1.0);
   const double along_length = std::clamp(patch.length_m / side, 0.0, 1.0);
   const double across_width = std::clamp(patch.width_m / side, 0.0, 1.0);
   const Vec3 width_G = closing_G.cross(approach_G);

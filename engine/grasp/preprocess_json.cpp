@@ -66,7 +66,8 @@ json ByType(const Items& items, TypeOf type_of) {
   std::array<int, kGraspTypes> n{};
   for (const auto& item : items) ++n[static_cast<int>(type_of(item))];
   json out = json::object();
-  for (int t = 0; t < kGraspTypes; ++t) out[std::string(ToString(static_cast<GraspType>(t)))] = n[t];
+  for (int t = 0; t < kGraspTypes; ++t)
+    out[std::string(ToString(static_cast<GraspType>(t)))] = n[t];
   return out;
 }
 

@@ -4,7 +4,6 @@
 // action's effects) call the free paths, skills and carries of the other files of
 // segments_internal.h. Where a motion reaches a keyframe's TCP pose on another IK solution, the
 // keyframes follow it (Rebranch).
-#include "grasp/grasp.h"
 #include "motion/segments.h"
 
 #include <algorithm>
@@ -15,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "grasp/grasp.h"
 #include "motion/segments_internal.h"
 #include "robot/kinematics.h"
 

@@ -209,9 +209,9 @@ class PlanReader {
 
   PlanHold ReadHold(const json& j, const std::string& at, int robot) const {
     ExpectObject(j, at);
-    CheckKeys(j, at,
-              {"robot", "subassembly", "index", "part", "X_PG", "width_m", "grasp_type",
-               "torque_scale"});
+    CheckKeys(
+        j, at,
+        {"robot", "subassembly", "index", "part", "X_PG", "width_m", "grasp_type", "torque_scale"});
     PlanHold h;
     h.robot = RobotValue(Member(j, at, "robot"), Join(at, "robot"));
     if (h.robot != robot) {

@@ -10,8 +10,8 @@
 #include <span>
 #include <utility>
 
-#include "grasp/grasp.h"
 #include "geometry/convex_hull.h"
+#include "grasp/grasp.h"
 #include "mating/insertion.h"
 #include "task/plan_validator_internal.h"
 

@@ -34,8 +34,8 @@ const std::vector<int>& TaskSearch::GraspIds(int node, int robot) {
       for (size_t i = 0; i < set->grasps.size(); ++i) {
         const Grasp& g = set->grasps[i];
         if ((g.type == GraspType::kFullPad ? add_full : add_reduced) == false) continue;
-        GraspRef ref{node,      static_cast<int>(i), g.part, g.X_PG, g.width_m, g.quality,
-                     g.type, g.torque_scale};
+        GraspRef ref{node,      static_cast<int>(i), g.part, g.X_PG,
+                     g.width_m, g.quality,           g.type, g.torque_scale};
         // Grasp sets of different end effectors of one node are told apart by the index offset.
         const int key_index = world_.robots[robot].grasp_set * 100000 + static_cast<int>(i);
         it->second.push_back(tables_.Grasp(node, key_index, ref));

@@ -9,9 +9,9 @@
 #include <cmath>
 #include <deque>
 
-#include "grasp/grasp.h"
 #include "core/frames.h"
 #include "geometry/convex_hull.h"
+#include "grasp/grasp.h"
 #include "verify/detail/best_split.h"
 #include "verify/detail/simulator.h"
 

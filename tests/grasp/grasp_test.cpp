@@ -114,9 +114,7 @@ std::vector<Grasp> FullPad(const std::vector<Grasp>& grasps) {
   return out;
 }
 
-size_t Reduced(const std::vector<Grasp>& grasps) {
-  return grasps.size() - FullPad(grasps).size();
-}
+size_t Reduced(const std::vector<Grasp>& grasps) { return grasps.size() - FullPad(grasps).size(); }
 
 double AngleBetween(const Vec3& a, const Vec3& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b));

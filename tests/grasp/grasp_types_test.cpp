@@ -195,8 +195,8 @@ TEST(GraspTypes, TheLpDecidesWhetherAReducedGraspSuffices) {
     return r ? r->feasible : false;
   };
   EXPECT_TRUE(check(Vec3::Ones())) << "full-pad";
-  const Vec3 fingertip = GraspTorqueScale({3e-5, 8e-3, 4e-3}, kFullArea, Vec3::UnitX(),
-                                          Vec3::UnitZ());
+  const Vec3 fingertip =
+      GraspTorqueScale({3e-5, 8e-3, 4e-3}, kFullArea, Vec3::UnitX(), Vec3::UnitZ());
   EXPECT_NEAR(fingertip.y(), 0.4, 1e-12);
   EXPECT_FALSE(check(fingertip)) << "fingertip at the same pose";
 }

@@ -163,9 +163,8 @@ struct TwoFingerPass {
 
 std::vector<GraspCandidate> SampleTwoFingerPass(const SamplerInput& in,
                                                 const TwoFingerGraspOptions& options,
-                                                const TwoFingerPass& pass,
-                                                GripperCollision& world, std::mt19937_64& rng,
-                                                const RunContext& ctx) {
+                                                const TwoFingerPass& pass, GripperCollision& world,
+                                                std::mt19937_64& rng, const RunContext& ctx) {
   std::vector<GraspCandidate> out;
   const EndEffector& ee = *in.ee;
   const MeshQuery& part = *in.part;
@@ -347,8 +346,7 @@ std::vector<GraspCandidate> SampleVacuum(const SamplerInput& in, const VacuumGra
       PlanarPatches(part, tol, std::numbers::pi * radius * radius);
   const int n_patches = static_cast<int>(patches.size());
   for (int sample = 0;
-       sample < in.max_samples + n_patches && static_cast<int>(out.size()) < in.wanted;
-       ++sample) {
+       sample < in.max_samples + n_patches && static_cast<int>(out.size()) < in.wanted; ++sample) {
     if (sample % kStopCheckEvery == 0 && ctx.ShouldStop()) break;
     Vec3 p, n;
     if (sample < n_patches) {

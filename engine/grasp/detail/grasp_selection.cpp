@@ -155,8 +155,8 @@ bool ScoreCandidates(const Subassembly& sub, int s, int e, const EndEffector& ee
 // tiers (assembly and pick, assembly only, pick only, neither), each pick spread away from every
 // grasp already `chosen` (`rot_scale`: metres per radian of approach angle), and interleaves the
 // assembly and the other half. Returns indices into `kept`; adds them to `chosen`.
-std::vector<int> SpreadTiers(const ScoredCandidates& scored, bool reduced, int n,
-                             double rot_scale, std::vector<int>& chosen, const RunContext& ctx) {
+std::vector<int> SpreadTiers(const ScoredCandidates& scored, bool reduced, int n, double rot_scale,
+                             std::vector<int>& chosen, const RunContext& ctx) {
   // Spread picks among a subset of the candidates (indices into `kept`), away from every grasp
   // already in the set.
   auto spread = [&](const std::vector<int>& among, int want) {
