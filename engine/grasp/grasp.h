@@ -3,9 +3,11 @@
 
 #include <array>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/pose.h"
+#include "grasp/grasp_type.h"
 #include "model/project.h"
 
 namespace wrap {
@@ -36,16 +38,54 @@ struct Grasp {
   std::array<Vec3, 2> contacts_P = {Vec3::Zero(), Vec3::Zero()};
   /// Two-finger: the smaller of the two pads' contact areas; vacuum: the cup disc [m^2].
   double contact_area_m2 = 0.0;
+  GraspType type = GraspType::kFullPad;  ///< Full-pad, partial-pad or fingertip.
+  /// The grasp's torque limits as fractions of the end effector's adopted box, per axis of G
+  /// (GraspTorqueScale: 1 for full-pad and vacuum grasps). Its box: GraspLimits.
+  Vec3 torque_scale = Vec3::Ones();
 };
+
+/// The contact patch of a reduced two-finger grasp, as the sampler measured it on the smaller
+/// of the two pads.
+struct PadPatch {
+  double area_m2 = 0.0;   ///< Touching area [m^2].
+  double width_m = 0.0;   ///< Extent across the pad's width (normal to the approach) [m].
+  double length_m = 0.0;  ///< Extent along the pad's length (along the approach) [m].
+};
+
+/// The physical model of a reduced grasp's limits (docs/algorithms.md "Grasp types"), as
+/// fractions of the adopted box, which holds for any contact of at least `full_area_m2` (a
+/// square patch of that area is the reference): forces keep their bounds (Coulomb friction
+/// mu * grip force does not depend on the contact area; the push along the closing axis is the
+/// grip itself); the torque about the closing axis (torsional friction) scales with the patch's
+/// radius, sqrt(area / full_area); the torque about the pad's width axis with the patch's length
+/// and the torque about the approach axis with its width (the pressure moment over the patch),
+/// each over the reference square's side. All capped at 1. `closing_G`, `approach_G`: the
+/// end effector's axes in G (unit, along G's axes). Returns the scale per axis of G.
+Vec3 GraspTorqueScale(const PadPatch& patch, double full_area_m2, const Vec3& closing_G,
+                      const Vec3& approach_G);
+
+/// The wrench limits of grasp `g` given the holding robot's limits `limits`: the two-finger box's
+/// torques scaled by g.torque_scale; the vacuum boxes as they are. The one place a grasp's box
+/// is made (planner, validator, motion, simulation).
+WrenchLimits GraspLimits(const WrenchLimits& limits, const Vec3& torque_scale);
+inline WrenchLimits GraspLimits(const WrenchLimits& limits, const Grasp& g) {
+  return GraspLimits(limits, g.torque_scale);
+}
 
 /// The grasps of one subassembly for one end effector, spread over its surface: ordered by
 /// farthest-point selection, so every prefix is itself spread (the planner's widening takes the
-/// first k).
+/// first k). Full-pad grasps first, then the reduced ones (partial-pad, fingertip).
 struct GraspSet {
   std::string end_effector;                            ///< Catalog end-effector name.
   EndEffectorKind kind = EndEffectorKind::kTwoFinger;  ///< Its kind.
-  std::vector<Grasp> grasps;                           ///< At most the requested set size.
+  /// At most the requested set size of full-pad grasps, then at most as many reduced ones.
+  std::vector<Grasp> grasps;
   int candidates = 0;  ///< Collision-free candidates the set was selected from (statistics).
+  /// Of them, per GraspType (index: the enum's value).
+  std::array<int, kGraspTypes> candidates_by_type = {0, 0, 0};
+  /// Of them, per GraspType, those whose gripper clears the mating partner at the mating pose
+  /// (the assembly grasps the set's tiers put first).
+  std::array<int, kGraspTypes> assembly_candidates_by_type = {0, 0, 0};
 };
 
 /// Options of the two-finger antipodal sampler.
@@ -65,6 +105,19 @@ struct TwoFingerGraspOptions {
   /// Rays across the pad's width and along its length for the contact test. Default 4 x 6.
   int pad_rays_width = 4;
   int pad_rays_length = 6;
+  /// Reduced grasps (partial-pad and fingertip), sampled after the full-pad ones and added to
+  /// each set after them (so the planner's widening reaches them last). Default true.
+  bool reduced = true;
+  /// Least contact of a reduced grasp on each pad [m^2]. Default 0.2 cm^2: a patch of about
+  /// 4.5 x 4.5 mm, at least two cells of the reduced pass's pad grid; below it the pad meets
+  /// an edge or a point, where no contact patch (and no torque capacity) can be relied on.
+  double min_reduced_contact_m2 = 2e-5;
+  /// Fingertip grasps: how far the pads' tips reach past the contacts [m]. Default 1.5 mm.
+  double fingertip_reach_m = 1.5e-3;
+  /// Rays across the pad's width and along its length in the reduced pass (finer: the patches
+  /// are small). Default 8 x 8.
+  int reduced_rays_width = 8;
+  int reduced_rays_length = 8;
 };
 
 /// Options of the vacuum sampler.

@@ -234,10 +234,23 @@ Result<SampledCandidates> SampleCandidates(const Project& project, const Project
     in.friction = out.friction;
     in.wanted = pool;
     in.max_samples = max_samples;
-    candidates[p * num_ee + e] =
-        effectors[e].kind == EndEffectorKind::kVacuum
-            ? detail::SampleVacuum(in, options.vacuum, local, rng, ctx)
-            : detail::SampleTwoFinger(in, options.two_finger, local, rng, ctx);
+    std::vector<detail::GraspCandidate>& mine = candidates[p * num_ee + e];
+    if (effectors[e].kind == EndEffectorKind::kVacuum) {
+      mine = detail::SampleVacuum(in, options.vacuum, local, rng, ctx);
+      return;
+    }
+    mine = detail::SampleTwoFinger(in, options.two_finger, local, rng, ctx);
+    if (!options.two_finger.reduced) return;
+    // Reduced grasps from a generator of their own: the full-pad candidates stay as they were.
+    std::mt19937_64 reduced_rng(
+        MixSeed(out.seed, 0x9e3779b97f4a7c15ULL ^ (static_cast<std::uint64_t>(task) + 1)));
+    // A larger pool: the features only reduced grasps hold are small (a collar, a button).
+    detail::SamplerInput reduced_in = in;
+    reduced_in.wanted = 4 * pool;
+    std::vector<detail::GraspCandidate> reduced =
+        detail::SampleTwoFingerReduced(reduced_in, options.two_finger, local, reduced_rng, ctx);
+    mine.insert(mine.end(), std::make_move_iterator(reduced.begin()),
+                std::make_move_iterator(reduced.end()));
   });
   if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp sampling"));
   for (int p = 0; p < num_parts; ++p) {

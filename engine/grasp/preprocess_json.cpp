@@ -1,5 +1,7 @@
 #include "grasp/preprocess_json.h"
 
+#include <array>
+
 #include <nlohmann/json.hpp>
 
 #include "model/catalog.h"
@@ -33,6 +35,10 @@ json PlacementJson(const StablePlacement& s) {
               {"equivalent_facets", s.equivalent_facets}};
 }
 
+json BoxJson(const WrenchBox& box) {
+  return json{{"force_N", Vec(box.force_N)}, {"torque_Nm", Vec(box.torque_Nm)}};
+}
+
 json GraspJson(const Project& project, const Subassembly& sub, const Grasp& g) {
   Iso3 X_AP = Iso3::Identity();
   for (size_t k = 0; k < sub.parts.size(); ++k) {
@@ -46,7 +52,23 @@ json GraspJson(const Project& project, const Subassembly& sub, const Grasp& g) {
               {"quality", g.quality},
               {"width_m", g.width_m},
               {"contacts_P", json::array({Vec(g.contacts_P[0]), Vec(g.contacts_P[1])})},
-              {"contact_area_m2", g.contact_area_m2}};
+              {"contact_area_m2", g.contact_area_m2},
+              {"type", std::string(ToString(g.type))},
+              {"torque_scale", Vec(g.torque_scale)},
+              {"wrench_limits", BoxJson(g.kind == EndEffectorKind::kVacuum
+                                            ? project.wrench_limits.vacuum_transport
+                                            : GraspLimits(project.wrench_limits, g).two_finger)}};
+}
+
+// Per grasp type, the count of `items` of that type.
+template <class Items, class TypeOf>
+json ByType(const Items& items, TypeOf type_of) {
+  std::array<int, kGraspTypes> n{};
+  for (const auto& item : items) ++n[static_cast<int>(type_of(item))];
+  json out = json::object();
+  for (int t = 0; t < kGraspTypes; ++t)
+    out[std::string(ToString(static_cast<GraspType>(t)))] = n[t];
+  return out;
 }
 
 }  // namespace
@@ -94,9 +116,21 @@ std::string PreprocessedToJson(const Project& project, const Preprocessed& resul
     json placements = json::array();
     for (const StablePlacement& s : sub.placements) placements.push_back(PlacementJson(s));
     json grasps = json::array();
-    json counts = json::object();
+    json counts = json::object(), by_type = json::object(), candidates = json::object();
+    json assembly = json::object();
     for (const GraspSet& set : sub.grasp_sets) {
       counts[set.end_effector] = set.grasps.size();
+      by_type[set.end_effector] = ByType(set.grasps, [](const Grasp& g) { return g.type; });
+      json c = json::object();
+      for (int t = 0; t < kGraspTypes; ++t) {
+        c[std::string(ToString(static_cast<GraspType>(t)))] = set.candidates_by_type[t];
+      }
+      candidates[set.end_effector] = c;
+      json a = json::object();
+      for (int t = 0; t < kGraspTypes; ++t) {
+        a[std::string(ToString(static_cast<GraspType>(t)))] = set.assembly_candidates_by_type[t];
+      }
+      assembly[set.end_effector] = a;
       for (const Grasp& g : set.grasps) grasps.push_back(GraspJson(project, sub, g));
     }
     subs.push_back(json{{"name", sub.name},
@@ -109,6 +143,9 @@ std::string PreprocessedToJson(const Project& project, const Preprocessed& resul
                                       {"volume_m3", sub.hull.volume_m3}}},
                         {"placements", placements},
                         {"grasp_counts", counts},
+                        {"grasp_counts_by_type", by_type},
+                        {"candidates_by_type", candidates},
+                        {"assembly_candidates_by_type", assembly},
                         {"grasps", grasps}});
   }
   doc["subassemblies"] = subs;

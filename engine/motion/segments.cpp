@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "grasp/grasp.h"
 #include "motion/segments_internal.h"
 #include "robot/kinematics.h"
 
@@ -474,8 +475,9 @@ std::optional<SoleLoad> SoleLoadOf(const TaskWorld& world, const PlanState& stat
   const PlanGrasp& g = state.grasp[robot];
   l.com_G = (world.X_AP[g.part] * g.X_PG).inverse() * com_A;
   const TaskRobot& tr = world.robots[robot];
-  l.box = tr.end_effector.kind == EndEffectorKind::kVacuum ? tr.limits.vacuum_transport
-                                                           : tr.limits.two_finger;
+  l.box = tr.end_effector.kind == EndEffectorKind::kVacuum
+              ? tr.limits.vacuum_transport
+              : GraspLimits(tr.limits, g.torque_scale).two_finger;
   return l;
 }
 

@@ -339,6 +339,8 @@ PlanAction TaskSearch::MakeAction(const SymState& s, const TaskAction& a, const 
     h.grasp.part = g.part;
     h.grasp.X_PG = g.X_PG;
     h.grasp.width_m = g.width_m;
+    h.grasp.type = g.type;
+    h.grasp.torque_scale = g.torque_scale;
     return h;
   };
   switch (a.type) {

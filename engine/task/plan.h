@@ -41,6 +41,7 @@
 
 #include "core/pose.h"
 #include "core/run_context.h"
+#include "grasp/grasp_type.h"
 #include "robot/kinematics.h"
 #include "task/failure.h"
 
@@ -61,6 +62,9 @@ struct PlanGrasp {
   int part = -1;                 ///< Held part (index into Project::parts).
   Iso3 X_PG = Iso3::Identity();  ///< Grasp (TCP) frame in the part frame.
   double width_m = 0.0;          ///< Two-finger: the width the fingers close to [m]; vacuum 0.
+  GraspType type = GraspType::kFullPad;  ///< Full-pad, partial-pad or fingertip (grasp.h).
+  /// The grasp's torque limits as fractions of the robot's box: GraspLimits(limits, scale).
+  Vec3 torque_scale = Vec3::Ones();
 };
 
 /// A robot holding an object with a grasp.

@@ -209,7 +209,9 @@ class PlanReader {
 
   PlanHold ReadHold(const json& j, const std::string& at, int robot) const {
     ExpectObject(j, at);
-    CheckKeys(j, at, {"robot", "subassembly", "index", "part", "X_PG", "width_m"});
+    CheckKeys(
+        j, at,
+        {"robot", "subassembly", "index", "part", "X_PG", "width_m", "grasp_type", "torque_scale"});
     PlanHold h;
     h.robot = RobotValue(Member(j, at, "robot"), Join(at, "robot"));
     if (h.robot != robot) {
@@ -222,6 +224,25 @@ class PlanReader {
     h.grasp.part = PartValue(Member(j, at, "part"), Join(at, "part"));
     h.grasp.X_PG = PoseValue(j, at, "X_PG");
     h.grasp.width_m = NonNegative(j, at, "width_m");
+    if (Find(j, "grasp_type")) {
+      const std::string type = String(j, at, "grasp_type");
+      bool known = false;
+      for (int t = 0; t < kGraspTypes; ++t) {
+        if (type == ToString(static_cast<GraspType>(t))) {
+          h.grasp.type = static_cast<GraspType>(t);
+          known = true;
+        }
+      }
+      if (!known) Bad(Join(at, "grasp_type"), "expected full_pad, partial_pad or fingertip");
+    }
+    if (Find(j, "torque_scale")) {
+      h.grasp.torque_scale = Vector3(j, at, "torque_scale");
+      for (int i = 0; i < 3; ++i) {
+        if (!(h.grasp.torque_scale[i] >= 0.0 && h.grasp.torque_scale[i] <= 1.0)) {
+          Bad(Join(at, "torque_scale"), "expected fractions in [0, 1]");
+        }
+      }
+    }
     return h;
   }
 

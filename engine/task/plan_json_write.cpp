@@ -133,12 +133,19 @@ ojson ActionJson(const Plan& plan, const PlanAction& a, size_t index) {
   for (int r : a.robots) robots.push_back(NameOr(plan.robots, r));
   for (int o : a.objects) objects.push_back(NameOr(plan.nodes, o));
   for (const PlanHold& h : a.grasps) {
-    grasps.push_back(ojson{{"robot", NameOr(plan.robots, h.robot)},
-                           {"subassembly", NameOr(plan.nodes, h.grasp.subassembly)},
-                           {"index", h.grasp.index},
-                           {"part", NameOr(plan.parts, h.grasp.part)},
-                           {"X_PG", PoseJson(h.grasp.X_PG)},
-                           {"width_m", h.grasp.width_m}});
+    ojson g{{"robot", NameOr(plan.robots, h.robot)},
+            {"subassembly", NameOr(plan.nodes, h.grasp.subassembly)},
+            {"index", h.grasp.index},
+            {"part", NameOr(plan.parts, h.grasp.part)},
+            {"X_PG", PoseJson(h.grasp.X_PG)},
+            {"width_m", h.grasp.width_m}};
+    // Reduced grasps only: a full-pad grasp's file reads as it did before grasp types existed.
+    if (h.grasp.type != GraspType::kFullPad) {
+      g["grasp_type"] = std::string(ToString(h.grasp.type));
+      const Vec3& s = h.grasp.torque_scale;
+      g["torque_scale"] = ojson::array({s.x(), s.y(), s.z()});
+    }
+    grasps.push_back(std::move(g));
   }
   ojson j{{"index", index},
           {"type", std::string(ToString(a.type))},

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "geometry/convex_hull.h"
+#include "grasp/grasp.h"
 #include "mating/insertion.h"
 #include "task/plan_validator_internal.h"
 
@@ -451,7 +452,7 @@ void Validator::AddObject(int node, const Iso3& X_WA, const std::vector<PlanHold
     const RobotModel& robot = robots_[h.robot];
     config.grippers.push_back(MakeGripper(robot.name, body_of_part[h.grasp.part],
                                           X_WA * X_AP_[h.grasp.part] * h.grasp.X_PG, robot.ee.kind,
-                                          robot.limits));
+                                          GraspLimits(robot.limits, h.grasp.torque_scale)));
   }
 }
 

@@ -203,6 +203,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
     search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
   };
   for (int level = 0; level < levels; ++level) {
+    if (level + 1 == levels) reduced_grasps_ = true;
     const Resolution res = ResolutionAt(level);
     // A level that is not the last gets a work budget: a seed whose grasps at this resolution
     // admit no plan would otherwise exhaust a large graph (100k-600k expansions: the tails of

@@ -352,6 +352,12 @@ class TaskSearch {
   int WindowDone(const SymState& s) const;
   std::vector<Node> nodes_;
   std::map<std::pair<int, int>, std::vector<int>> grasp_ids_;
+  /// Keys of grasp_ids_ whose reduced grasps (partial-pad, fingertip) are registered.
+  std::set<std::pair<int, int>> reduced_ids_;
+  /// Whether GraspIds includes the reduced grasps: from the last resolution level on. Before it,
+  /// neither the search nor the grasp ids (which seed the IK of edges) change when a set gains
+  /// reduced grasps, so plans found with full-pad grasps stay the same.
+  bool reduced_grasps_ = false;
   FlatMap<int> failed_level_;                                 // edge key -> level failed at
   std::unordered_map<std::uint64_t, EdgeOutcome> witnesses_;  // continuous edge key -> outcome
   struct CheapAnswer {

@@ -27,6 +27,8 @@ struct GraspRef {
   Iso3 X_PG = Iso3::Identity();
   double width_m = 0.0;
   double quality = 0.0;
+  GraspType type = GraspType::kFullPad;  ///< Full-pad, partial-pad or fingertip.
+  Vec3 torque_scale = Vec3::Ones();      ///< Its limits: GraspLimits(robot limits, scale).
 };
 
 /// A resting location: the pose of an object's assembly frame on the table.

@@ -23,12 +23,19 @@ TaskAction ActionOn(ActionType type, int robot, int node) {
 }  // namespace
 
 const std::vector<int>& TaskSearch::GraspIds(int node, int robot) {
-  auto [it, inserted] = grasp_ids_.try_emplace({node, world_.robots[robot].grasp_set});
-  if (inserted) {
+  const std::pair<int, int> key{node, world_.robots[robot].grasp_set};
+  auto [it, inserted] = grasp_ids_.try_emplace(key);
+  // Full-pad grasps when first asked; the reduced ones (after them in the set) once the last
+  // resolution level allows them.
+  const bool add_full = inserted;
+  const bool add_reduced = reduced_grasps_ && reduced_ids_.insert(key).second;
+  if (add_full || add_reduced) {
     if (const GraspSet* set = world_.grasp_set(node, robot)) {
       for (size_t i = 0; i < set->grasps.size(); ++i) {
         const Grasp& g = set->grasps[i];
-        GraspRef ref{node, static_cast<int>(i), g.part, g.X_PG, g.width_m, g.quality};
+        if ((g.type == GraspType::kFullPad ? add_full : add_reduced) == false) continue;
+        GraspRef ref{node,      static_cast<int>(i), g.part, g.X_PG,
+                     g.width_m, g.quality,           g.type, g.torque_scale};
         // Grasp sets of different end effectors of one node are told apart by the index offset.
         const int key_index = world_.robots[robot].grasp_set * 100000 + static_cast<int>(i);
         it->second.push_back(tables_.Grasp(node, key_index, ref));

@@ -95,6 +95,7 @@ MilestoneResult TaskSearch::FillWindow(int index, const std::vector<int>& steps,
   MilestoneResult result;
   const int levels = 3;
   for (int level = 0; level < levels; ++level) {
+    if (level + 1 == levels) reduced_grasps_ = true;
     if (Rounds(index, m, ResolutionAt(level), s0, c0, t0, {}, limits, result) !=
         SearchStatus::kExhausted) {
       break;
@@ -125,6 +126,7 @@ MilestoneResult TaskSearch::FillFlat(const SymState& s0, const ContState& c0) {
   }
   const int levels = 3;
   for (int level = 0; level < levels; ++level) {
+    if (level + 1 == levels) reduced_grasps_ = true;
     const SearchStatus status = Rounds(0, m, ResolutionAt(level), s0, c0,
                                        TaskClock(n_robots_, world_.num_nodes), {}, {}, result);
     if (status != SearchStatus::kExhausted) break;

@@ -13,8 +13,8 @@ StepConfiguration BuildWrenchConfig(const TaskWorld& world, const TaskTables& ta
     for (int p : world.tree->nodes[o.node].parts) {
       body_of[p] = static_cast<int>(config.bodies.size());
       object_of[p] = &o;
-      config.bodies.push_back({world.project->parts[p].name, world.part_mass[p],
-                               o.X_WA * world.part_com_A[p]});
+      config.bodies.push_back(
+          {world.project->parts[p].name, world.part_mass[p], o.X_WA * world.part_com_A[p]});
     }
   }
   for (const WrenchObject& o : objects) {
@@ -32,8 +32,8 @@ StepConfiguration BuildWrenchConfig(const TaskWorld& world, const TaskTables& ta
       const GraspRef& g = tables.grasp(grasp_id);
       const TaskRobot& r = world.robots[robot];
       const Iso3 X_WG = o.X_WA * world.X_AP[g.part] * g.X_PG;
-      config.grippers.push_back(
-          MakeGripper(r.name, body_of[g.part], X_WG, r.end_effector.kind, r.limits));
+      config.grippers.push_back(MakeGripper(r.name, body_of[g.part], X_WG, r.end_effector.kind,
+                                            GraspLimits(r.limits, g.torque_scale)));
     }
     if (o.resting) {
       for (auto& [part, points] : TableContacts(world, o.node, o.X_WA)) {

@@ -11,6 +11,7 @@
 
 #include "core/frames.h"
 #include "geometry/convex_hull.h"
+#include "grasp/grasp.h"
 #include "verify/detail/best_split.h"
 #include "verify/detail/simulator.h"
 
@@ -164,7 +165,7 @@ std::optional<std::map<int, double>> Simulator::BestSplit(int node) {
     SplitHolder h;
     h.A = GraspWrenchToWorld(G.linear(), G.translation() - p0);
     h.vacuum = scene_.robots[r].end_effector.kind == EndEffectorKind::kVacuum;
-    h.limits = limits_[r];
+    h.limits = HeldLimits(static_cast<int>(r));
     q.holders.push_back(h);
     robots.push_back(static_cast<int>(r));
   }
@@ -306,11 +307,15 @@ void Simulator::AverageWrench(int r, Vec3& f, Vec3& tau) {
   tau = mean.tail<3>();
 }
 
+WrenchLimits Simulator::HeldLimits(int r) const {
+  return GraspLimits(limits_[r], grasp_[r].torque_scale);
+}
+
 // Robot r's utilisation of its limits with wrench (f, tau) in its grasp frame, during insertion
 // `insert_action` (-1: none).
 double Simulator::GripperUtilisation(int r, const Vec3& f, const Vec3& tau, int insert_action) {
   const bool vacuum = scene_.robots[r].end_effector.kind == EndEffectorKind::kVacuum;
-  const WrenchLimits& lim = limits_[r];
+  const WrenchLimits lim = HeldLimits(r);
   const double fN = options_.zero_limit_force_N, fNm = options_.zero_limit_torque_Nm;
   double u = 0.0;
   if (!vacuum) {

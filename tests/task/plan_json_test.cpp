@@ -306,6 +306,37 @@ TEST(PlanJson, UtilisationRoundTripsAndIsChecked) {
       << bad.error().message;
 }
 
+// A reduced grasp's type and torque scale: written only for reduced grasps (a full-pad grasp's
+// entry reads as before grasp types existed), read back exactly, checked.
+TEST(PlanJson, ReducedGraspTypeRoundTripsAndIsChecked) {
+  Plan plan = StoolPlan();
+  ASSERT_FALSE(plan.actions[1].grasps.empty());
+  PlanGrasp& g = plan.actions[1].grasps[0].grasp;
+  g.type = GraspType::kFingertip;
+  g.torque_scale = Vec3(0.5, 0.25, 1.0);
+  const std::string text = SerializePlan(plan);
+  auto parsed = ParsePlan(text, "plan.json");
+  ASSERT_TRUE(parsed.has_value()) << parsed.error().message;
+  const PlanGrasp& back = parsed->actions[1].grasps[0].grasp;
+  EXPECT_EQ(back.type, GraspType::kFingertip);
+  EXPECT_EQ(back.torque_scale, Vec3(0.5, 0.25, 1.0));
+  EXPECT_EQ(parsed->actions[0].grasps.at(0).grasp.type, GraspType::kFullPad);
+  json d = json::parse(text);
+  EXPECT_EQ(d["actions"][1]["grasps"][0]["grasp_type"], "fingertip");
+  EXPECT_FALSE(d["actions"][0]["grasps"][0].contains("grasp_type"));
+  EXPECT_FALSE(d["actions"][0]["grasps"][0].contains("torque_scale"));
+  json big = d;
+  big["actions"][1]["grasps"][0]["torque_scale"] = {0.5, 1.5, 1.0};
+  auto bad = ParsePlan(big.dump(), "plan.json");
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find("torque_scale: expected fractions in [0, 1]"),
+            std::string::npos)
+      << bad.error().message;
+  json unknown = d;
+  unknown["actions"][1]["grasps"][0]["grasp_type"] = "palm";
+  ASSERT_FALSE(ParsePlan(unknown.dump(), "plan.json").has_value());
+}
+
 // Motion segments say what each waited for; plans written before they did still read (no
 // wait); a wait that is not a known one or names no segment is refused.
 TEST(PlanJson, SegmentWaitsRoundTripAndOldPlansStillRead) {

@@ -74,12 +74,13 @@ double AngleBetween(const Vec3& a, const Vec3& b) {
 
 // How much of a finger pad touches the part: rays across the pad rectangle (centre `c`, width
 // axis e_w, length axis e_l) toward the part along `in`. The pad settles on the most protruding
-// point; points within `tol` of it touch. Returns the touching area [m^2], or -1 when the pad
-// cannot reach the contact: something protrudes more than `tol` in front of it, or the ray
-// starts inside material. Returns 0 early once fewer than `min_hits` rays can touch.
-double PadContact(const MeshQuery& part, const Vec3& c, const Vec3& in, const Vec3& e_w,
-                  const Vec3& e_l, double width, double length, double tol, double back, int rays_w,
-                  int rays_l, int min_hits) {
+// point; points within `tol` of it touch. Returns the touching area [m^2] and the extents of the
+// touching rays' cells across the width and along the length, or area -1 when the pad cannot
+// reach the contact: something protrudes more than `tol` in front of it, or the ray starts
+// inside material. Returns area 0 early once fewer than `min_hits` rays can touch.
+PadPatch PadContact(const MeshQuery& part, const Vec3& c, const Vec3& in, const Vec3& e_w,
+                    const Vec3& e_l, double width, double length, double tol, double back,
+                    int rays_w, int rays_l, int min_hits) {
   double s_min = std::numeric_limits<double>::infinity();
   double s[64];
   int n = 0, hits = 0, misses = 0;
@@ -91,21 +92,40 @@ double PadContact(const MeshQuery& part, const Vec3& c, const Vec3& in, const Ve
       const auto hit = part.Cast(g - back * in, in, 0.0, back + tol);
       double depth = std::numeric_limits<double>::infinity();
       if (hit) {
-        if (part.normal(hit->triangle).dot(in) > 0.0) return -1.0;  // started inside material
+        if (part.normal(hit->triangle).dot(in) > 0.0) return {-1.0};  // started inside material
         depth = hit->t - back;
-        if (depth < -tol) return -1.0;
+        if (depth < -tol) return {-1.0};
         s_min = std::min(s_min, depth);
         ++hits;
       } else if (++misses > total - min_hits) {
-        return 0.0;
+        return {0.0};
       }
       if (n < 64) s[n++] = depth;
     }
   }
-  if (hits == 0) return 0.0;
+  if (hits == 0) return {0.0};
   int touching = 0;
-  for (int k = 0; k < n; ++k) touching += s[k] <= s_min + tol ? 1 : 0;
-  return width * length * touching / (rays_w * rays_l);
+  int i_lo = rays_w, i_hi = -1, j_lo = rays_l, j_hi = -1;
+  for (int k = 0; k < n; ++k) {
+    if (s[k] > s_min + tol) continue;
+    ++touching;
+    const int i = k / rays_l, j = k % rays_l;
+    i_lo = std::min(i_lo, i);
+    i_hi = std::max(i_hi, i);
+    j_lo = std::min(j_lo, j);
+    j_hi = std::max(j_hi, j);
+  }
+  PadPatch patch;
+  patch.area_m2 = width * length * touching / (rays_w * rays_l);
+  patch.width_m = touching > 0 ? width * (i_hi - i_lo + 1) / rays_w : 0.0;
+  patch.length_m = touching > 0 ? length * (j_hi - j_lo + 1) / rays_l : 0.0;
+  return patch;
+}
+
+// The smaller of two pads' patches, extent by extent.
+PadPatch Smaller(const PadPatch& a, const PadPatch& b) {
+  return {std::min(a.area_m2, b.area_m2), std::min(a.width_m, b.width_m),
+          std::min(a.length_m, b.length_m)};
 }
 
 // The rotation whose columns are the images of the TCP axes (closing c_T, approach a_T) in P.
@@ -118,14 +138,36 @@ Mat3 FrameFromAxes(const Vec3& c_P, const Vec3& a_P, const Vec3& c_T, const Vec3
 
 }  // namespace
 
-std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
-                                            const TwoFingerGraspOptions& options,
-                                            GripperCollision& world, std::mt19937_64& rng,
-                                            const RunContext& ctx) {
+namespace {
+
+// One pad placement along the approach tried per approach direction: how far the pads are
+// pulled back from being centred on the contacts, and the type a grasp found there gets.
+struct PadDepth {
+  double shift = 0.0;
+  GraspType type = GraspType::kFullPad;
+  // The smaller pad's contact must be below this [m^2] (a partial-pad grasp: less than full).
+  double max_area = std::numeric_limits<double>::infinity();
+};
+
+// What distinguishes the full-pad pass from the reduced one.
+struct TwoFingerPass {
+  int rays_w = 4, rays_l = 6;
+  double min_area = 0.0;  // least contact on each pad [m^2]
+  std::array<PadDepth, 3> depths{};
+  int num_depths = 0;
+  // Try first the approach straight down in the assembly's frame (where it has one about the
+  // closing line): a fingertip grasp keeps the gripper above what the part stands in, and a
+  // tilted one dips the fingers' corners.
+  bool from_above_first = false;
+};
+
+std::vector<GraspCandidate> SampleTwoFingerPass(const SamplerInput& in,
+                                                const TwoFingerGraspOptions& options,
+                                                const TwoFingerPass& pass, GripperCollision& world,
+                                                std::mt19937_64& rng, const RunContext& ctx) {
   std::vector<GraspCandidate> out;
   const EndEffector& ee = *in.ee;
   const MeshQuery& part = *in.part;
-  if (ee.stroke_m <= 0.0 || part.area() <= 0.0) return out;
   const double alpha = std::atan(in.friction);
   const double max_width = ee.stroke_m - 2.0 * options.clearance_m;
   // TCP-frame axes: closing (catalog, in F) and approach (F's z), orthonormalised.
@@ -136,13 +178,13 @@ std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
   const Vec3 pad_T = ee.X_FT.inverse() * ee.pad_center_F;
   const double pad_area = ee.pad_width_m * ee.pad_length_m;
   const double back = options.clearance_m + options.contact_tolerance_m + 2e-3;
-  const int rays_w = std::clamp(options.pad_rays_width, 1, 8);
-  const int rays_l = std::clamp(options.pad_rays_length, 1, 8);
+  const int rays_w = std::clamp(pass.rays_w, 1, 8);
+  const int rays_l = std::clamp(pass.rays_l, 1, 8);
   // Each touching ray stands for 1 / (rays_w rays_l) of the pad.
-  const int min_hits = pad_area > 0.0
-                           ? static_cast<int>(std::ceil(
-                                 options.min_pad_contact_m2 / pad_area * rays_w * rays_l - 1e-9))
-                           : 1;
+  const int min_hits =
+      pad_area > 0.0
+          ? static_cast<int>(std::ceil(pass.min_area / pad_area * rays_w * rays_l - 1e-9))
+          : 1;
 
   for (int sample = 0; sample < in.max_samples && static_cast<int>(out.size()) < in.wanted;
        ++sample) {
@@ -166,39 +208,41 @@ std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
     const Vec3 m = 0.5 * (p + q);
 
     const double phase0 = 2.0 * std::numbers::pi * Uniform01(rng);
-    const int approaches = std::clamp(options.approach_samples, 1, kMaxApproaches);
+    const int approaches = std::clamp(options.approach_samples, 1, kMaxApproaches - 1);
     // A pad rectangle is symmetric under a half turn: approaches pi apart share pad tests.
     const int period = approaches % 2 == 0 ? approaches / 2 : approaches;
-    // Two depths per approach: the pads centred on the contacts, and a shallow grasp with the
-    // contacts near the fingertips (the tips 3 mm past them), which picks thin parts lying on a
-    // table whose top the centred pads would reach into.
-    const double shallow = std::max(0.0, 0.5 * ee.pad_length_m - 0.003);
-    const int depths = shallow > 1e-4 ? 2 : 1;
-    std::array<std::array<double, kMaxApproaches>, 2> pad_p, pad_q;
+    std::array<std::array<PadPatch, kMaxApproaches>, 3> pad_p, pad_q;
     for (auto* pads : {&pad_p, &pad_q}) {
-      for (auto& row : *pads) row.fill(std::numeric_limits<double>::quiet_NaN());
+      for (auto& row : *pads) row.fill(PadPatch{std::numeric_limits<double>::quiet_NaN()});
     }
+    // Down in A, in P, across the closing line (k = -1 below); none when nearly along it.
+    const Vec3 down_P = in.X_AP.linear().transpose() * -Vec3::UnitZ();
+    const Vec3 down_across = down_P - down_P.dot(d) * d;
+    const int first = pass.from_above_first && down_across.norm() > 0.5 ? -1 : 0;
     bool found = false;
-    for (int k = 0; k < approaches && !found; ++k) {
-      const Vec3 a =
-          Tilted(d, 0.5 * std::numbers::pi, phase0 + 2.0 * std::numbers::pi * k / approaches);
+    for (int k = first; k < approaches && !found; ++k) {
+      const Vec3 a = k < 0 ? Vec3(down_across.normalized())
+                           : Tilted(d, 0.5 * std::numbers::pi,
+                                    phase0 + 2.0 * std::numbers::pi * k / approaches);
       const Vec3 e_w = d.cross(a);
       // Pads: the one at -d pushes p along +d, the one at +d pushes q along -d.
-      const int key = k % period;
-      for (int depth = 0; depth < depths; ++depth) {
-        const double shift = depth == 0 ? 0.0 : shallow;
-        double& area_p = pad_p[depth][key];
-        if (std::isnan(area_p)) {
-          area_p = PadContact(part, p - shift * a, d, e_w, a, ee.pad_width_m, ee.pad_length_m,
-                              options.contact_tolerance_m, back, rays_w, rays_l, min_hits);
+      const int key = k < 0 ? kMaxApproaches - 1 : k % period;
+      for (int depth = 0; depth < pass.num_depths; ++depth) {
+        const double shift = pass.depths[depth].shift;
+        PadPatch& patch_p = pad_p[depth][key];
+        if (std::isnan(patch_p.area_m2)) {
+          patch_p = PadContact(part, p - shift * a, d, e_w, a, ee.pad_width_m, ee.pad_length_m,
+                               options.contact_tolerance_m, back, rays_w, rays_l, min_hits);
         }
-        if (area_p < options.min_pad_contact_m2) continue;
-        double& area_q = pad_q[depth][key];
-        if (std::isnan(area_q)) {
-          area_q = PadContact(part, q - shift * a, -d, e_w, a, ee.pad_width_m, ee.pad_length_m,
-                              options.contact_tolerance_m, back, rays_w, rays_l, min_hits);
+        if (patch_p.area_m2 < pass.min_area) continue;
+        PadPatch& patch_q = pad_q[depth][key];
+        if (std::isnan(patch_q.area_m2)) {
+          patch_q = PadContact(part, q - shift * a, -d, e_w, a, ee.pad_width_m, ee.pad_length_m,
+                               options.contact_tolerance_m, back, rays_w, rays_l, min_hits);
         }
-        if (area_q < options.min_pad_contact_m2) continue;
+        if (patch_q.area_m2 < pass.min_area) continue;
+        const PadPatch patch = Smaller(patch_p, patch_q);
+        if (patch.area_m2 >= pass.depths[depth].max_area) continue;
         Iso3 X_PG = Iso3::Identity();
         X_PG.linear() = FrameFromAxes(d, a, c_T, a_T);
         X_PG.translation() = m - X_PG.linear() * pad_T - shift * a;
@@ -212,7 +256,11 @@ std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
         c.grasp.X_PG = X_PG;
         c.grasp.width_m = width;
         c.grasp.contacts_P = {q, p};  // the finger on G's +x (+d) side touches q
-        c.grasp.contact_area_m2 = std::min(area_p, area_q);
+        c.grasp.contact_area_m2 = patch.area_m2;
+        c.grasp.type = pass.depths[depth].type;
+        if (c.grasp.type != GraspType::kFullPad) {
+          c.grasp.torque_scale = GraspTorqueScale(patch, options.min_pad_contact_m2, c_T, a_T);
+        }
         c.center_P = m;
         c.axis_P = d;
         c.approach_P = a;
@@ -224,6 +272,51 @@ std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
     }
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
+                                            const TwoFingerGraspOptions& options,
+                                            GripperCollision& world, std::mt19937_64& rng,
+                                            const RunContext& ctx) {
+  const EndEffector& ee = *in.ee;
+  if (ee.stroke_m <= 0.0 || in.part->area() <= 0.0) return {};
+  TwoFingerPass pass;
+  pass.rays_w = options.pad_rays_width;
+  pass.rays_l = options.pad_rays_length;
+  pass.min_area = options.min_pad_contact_m2;
+  // Two depths per approach: the pads centred on the contacts, and a shallow grasp with the
+  // contacts near the fingertips (the tips 3 mm past them), which picks thin parts lying on a
+  // table whose top the centred pads would reach into.
+  const double shallow = std::max(0.0, 0.5 * ee.pad_length_m - 0.003);
+  pass.depths[pass.num_depths++] = {0.0, GraspType::kFullPad};
+  if (shallow > 1e-4) pass.depths[pass.num_depths++] = {shallow, GraspType::kFullPad};
+  return SampleTwoFingerPass(in, options, pass, world, rng, ctx);
+}
+
+std::vector<GraspCandidate> SampleTwoFingerReduced(const SamplerInput& in,
+                                                   const TwoFingerGraspOptions& options,
+                                                   GripperCollision& world, std::mt19937_64& rng,
+                                                   const RunContext& ctx) {
+  const EndEffector& ee = *in.ee;
+  if (ee.stroke_m <= 0.0 || in.part->area() <= 0.0 || ee.pad_length_m <= 0.0) return {};
+  TwoFingerPass pass;
+  pass.rays_w = options.reduced_rays_width;
+  pass.rays_l = options.reduced_rays_length;
+  pass.min_area = options.min_reduced_contact_m2;
+  // Pads centred on the contacts touching less than a full pad (partial-pad), then the tips
+  // 3 mm past the contacts (the full-pad pass's shallow depth) touching less than a full pad,
+  // then the tips `fingertip_reach_m` past them with any contact (fingertip; the full-pad pass
+  // does not reach this far forward). Their limits come from the patch either way.
+  const double half = 0.5 * ee.pad_length_m;
+  pass.depths[pass.num_depths++] = {0.0, GraspType::kPartialPad, options.min_pad_contact_m2};
+  pass.depths[pass.num_depths++] = {std::max(0.0, half - 0.003), GraspType::kFingertip,
+                                    options.min_pad_contact_m2};
+  pass.depths[pass.num_depths++] = {std::max(0.0, half - std::max(0.0, options.fingertip_reach_m)),
+                                    GraspType::kFingertip};
+  pass.from_above_first = true;
+  return SampleTwoFingerPass(in, options, pass, world, rng, ctx);
 }
 
 std::vector<GraspCandidate> SampleVacuum(const SamplerInput& in, const VacuumGraspOptions& options,
@@ -253,8 +346,7 @@ std::vector<GraspCandidate> SampleVacuum(const SamplerInput& in, const VacuumGra
       PlanarPatches(part, tol, std::numbers::pi * radius * radius);
   const int n_patches = static_cast<int>(patches.size());
   for (int sample = 0;
-       sample < in.max_samples + n_patches && static_cast<int>(out.size()) < in.wanted;
-       ++sample) {
+       sample < in.max_samples + n_patches && static_cast<int>(out.size()) < in.wanted; ++sample) {
     if (sample % kStopCheckEvery == 0 && ctx.ShouldStop()) break;
     Vec3 p, n;
     if (sample < n_patches) {

@@ -45,6 +45,18 @@ std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
                                             GripperCollision& world, std::mt19937_64& rng,
                                             const RunContext& ctx);
 
+/// Reduced two-finger sampling (partial-pad and fingertip grasps, grasp.h GraspType): as
+/// SampleTwoFinger, on a finer pad grid, trying first the approach straight down in the
+/// assembly's frame, with the pads centred on the contacts touching less than
+/// options.min_pad_contact_m2 (partial-pad), pulled back so that their tips stand 3 mm past the
+/// contacts touching less than that, or pulled back to options.fingertip_reach_m past them with
+/// any contact (fingertip); at least options.min_reduced_contact_m2 on each pad. Each grasp has
+/// its torque scale (GraspTorqueScale).
+std::vector<GraspCandidate> SampleTwoFingerReduced(const SamplerInput& in,
+                                                   const TwoFingerGraspOptions& options,
+                                                   GripperCollision& world, std::mt19937_64& rng,
+                                                   const RunContext& ctx);
+
 /// Vacuum sampling: a surface point whose cup disc rests on a flat patch (every test point of
 /// the disc on the tangent plane within the tolerance, normals aligned), cup axis along the
 /// normal, and a rotation about it for which the gripper, backed off by the standoff, does not

@@ -151,14 +151,14 @@ bool ScoreCandidates(const Subassembly& sub, int s, int e, const EndEffector& ee
   return true;
 }
 
-// Picks up to n of the scored candidates in tiers (assembly and pick, assembly only, pick only,
-// neither), each pick spread away from every grasp already in the set (`rot_scale`: metres per
-// radian of approach angle), and interleaves the assembly and the other half.
-GraspSet SpreadGrasps(const ScoredCandidates& scored, const EndEffector& ee, int n,
-                      double rot_scale, const RunContext& ctx) {
+// Picks up to n of the scored candidates whose `reduced` flag (not full-pad) is as asked, in
+// tiers (assembly and pick, assembly only, pick only, neither), each pick spread away from every
+// grasp already `chosen` (`rot_scale`: metres per radian of approach angle), and interleaves the
+// assembly and the other half. Returns indices into `kept`; adds them to `chosen`.
+std::vector<int> SpreadTiers(const ScoredCandidates& scored, bool reduced, int n, double rot_scale,
+                             std::vector<int>& chosen, const RunContext& ctx) {
   // Spread picks among a subset of the candidates (indices into `kept`), away from every grasp
   // already in the set.
-  std::vector<int> chosen;
   auto spread = [&](const std::vector<int>& among, int want) {
     std::vector<int> picked =
         FarthestPointOrder(scored.x, scored.a, scored.quality, among, chosen, want, rot_scale, ctx);
@@ -168,6 +168,7 @@ GraspSet SpreadGrasps(const ScoredCandidates& scored, const EndEffector& ee, int
   // Tiers: assembly and pick, assembly only, pick only, neither.
   std::vector<int> tier[4];
   for (int i = 0; i < static_cast<int>(scored.kept.size()); ++i) {
+    if ((scored.kept[i]->grasp.type != GraspType::kFullPad) != reduced) continue;
     tier[(scored.clear_of_partner[i] ? 0 : 2) + (scored.pickable_at_rest[i] ? 0 : 1)].push_back(i);
   }
   auto take = [&](std::vector<int>& list, int from_tier, int quota) {
@@ -191,18 +192,37 @@ GraspSet SpreadGrasps(const ScoredCandidates& scored, const EndEffector& ee, int
     tier[0] = left;
     take(second, 0, n - static_cast<int>(first.size()));
   }
+  std::vector<int> order;
+  for (size_t k = 0; k < std::max(first.size(), second.size()); ++k) {
+    for (const std::vector<int>* list : {&first, &second}) {
+      if (k < list->size()) order.push_back((*list)[k]);
+    }
+  }
+  return order;
+}
+
+// The set: up to n full-pad grasps (SpreadTiers), then up to n reduced ones, spread away from
+// the full-pad grasps too. The full-pad part is what it was before reduced grasps existed, so
+// plans that find their grasps there do not change; the planner's widening reaches the rest.
+GraspSet SpreadGrasps(const ScoredCandidates& scored, const EndEffector& ee, int n,
+                      double rot_scale, const RunContext& ctx) {
+  std::vector<int> chosen;
+  std::vector<int> order = SpreadTiers(scored, false, n, rot_scale, chosen, ctx);
+  const std::vector<int> reduced = SpreadTiers(scored, true, n, rot_scale, chosen, ctx);
+  order.insert(order.end(), reduced.begin(), reduced.end());
   GraspSet set;
   set.end_effector = ee.name;
   set.kind = ee.kind;
   set.candidates = static_cast<int>(scored.kept.size());
-  for (size_t k = 0; k < std::max(first.size(), second.size()); ++k) {
-    for (const std::vector<int>* list : {&first, &second}) {
-      if (k >= list->size()) continue;
-      const int i = (*list)[k];
-      Grasp g = scored.kept[i]->grasp;
-      g.quality = scored.quality[i];
-      set.grasps.push_back(std::move(g));
-    }
+  for (size_t i = 0; i < scored.kept.size(); ++i) {
+    const int type = static_cast<int>(scored.kept[i]->grasp.type);
+    ++set.candidates_by_type[type];
+    if (scored.clear_of_partner[i]) ++set.assembly_candidates_by_type[type];
+  }
+  for (int i : order) {
+    Grasp g = scored.kept[i]->grasp;
+    g.quality = scored.quality[i];
+    set.grasps.push_back(std::move(g));
   }
   return set;
 }

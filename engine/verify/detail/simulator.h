@@ -191,6 +191,9 @@ class Simulator {
   void GripWrench(int r, Vec3& f_G, Vec3& tau_G, double t) const;
   void AverageWrench(int r, Vec3& f, Vec3& tau);
   double GripperUtilisation(int r, const Vec3& f, const Vec3& tau, int insert_action);
+  // Robot r's wrench limits with the grasp its weld holds (GraspLimits: a reduced grasp's box is
+  // smaller). The weld itself is rigid; the box is what its measured wrench is judged against.
+  WrenchLimits HeldLimits(int r) const;
   bool MeasureGripper(int r, double t, const std::vector<int>& inserting, int current);
   void MeasureTable();
   void MeasureConnections();
