@@ -72,8 +72,8 @@ int Preprocess(const PreprocessArgs& args, std::ostream& out, std::ostream& err)
   out << "\nSubassemblies (parts first, then steps):\n";
   for (const Subassembly& s : r.subassemblies) PrintSubassembly(p, s, out);
   out << "\nTimings [s]:";
-  for (const char* key :
-       {"subassemblies", "hulls", "placements", "table_slots", "grasp_candidates", "grasp_sets"}) {
+  for (const char* key : {"subassemblies", "hulls", "placements", "table_slots", "grasp_candidates",
+                          "grasp_sets", "reduced_grasps"}) {
     if (auto it = r.times.find(key); it != r.times.end())
       out << " " << key << " " << Fmt("%.3f", it->second);
   }

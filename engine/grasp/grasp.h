@@ -108,6 +108,10 @@ struct TwoFingerGraspOptions {
   /// Reduced grasps (partial-pad and fingertip), sampled after the full-pad ones and added to
   /// each set after them (so the planner's widening reaches them last). Default true.
   bool reduced = true;
+  /// ... for the parts that need them: those whose own full-pad candidates that clear the
+  /// mating partner at the mating pose number fewer than this (a wheel, a short collar, a
+  /// button). 0: none; a large number: every part. Default 4.
+  int reduced_below = 4;
   /// Least contact of a reduced grasp on each pad [m^2]. Default 0.2 cm^2: a patch of about
   /// 4.5 x 4.5 mm, at least two cells of the reduced pass's pad grid; below it the pad meets
   /// an edge or a point, where no contact patch (and no torque capacity) can be relied on.

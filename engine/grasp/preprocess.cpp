@@ -177,8 +177,39 @@ struct SampledCandidates {
   std::vector<Iso3> X_AP;  // Assembled pose of each part, then the table's (identity).
   int table_body = -1;     // The table's index among the world's parts.
   std::optional<detail::GripperCollision> world;
+  std::vector<std::unique_ptr<MeshQuery>> rays;         // Per unique part (shared.unique).
   std::vector<std::vector<GraspCandidate>> candidates;  // Index part * num_ee + end effector.
+  int pool = 0;         // Candidates wanted per part and end effector.
+  int max_samples = 0;  // Samples tried for them.
 };
+
+// The sampler's input for unique part `p` and end effector `e`.
+detail::SamplerInput SamplerInputFor(const SampledCandidates& sampled,
+                                     const std::vector<EndEffector>& effectors,
+                                     const Preprocessed& out, int p, int e) {
+  detail::SamplerInput in;
+  in.part = sampled.rays[p].get();
+  in.part_index = p;
+  in.X_AP = sampled.X_AP[p];
+  in.ee = &effectors[e];
+  in.ee_index = e;
+  in.friction = out.friction;
+  in.wanted = sampled.pool;
+  in.max_samples = sampled.max_samples;
+  return in;
+}
+
+// The parts that share a unique part's mesh get its candidates (their own part index).
+void CopyToSharedMeshes(const SharedMeshes& shared, int num_ee, SampledCandidates& sampled) {
+  for (int p = 0; p < static_cast<int>(shared.same.size()); ++p) {
+    if (shared.same[p] == p) continue;
+    for (int e = 0; e < num_ee; ++e) {
+      std::vector<GraspCandidate>& dst = sampled.candidates[p * num_ee + e];
+      dst = sampled.candidates[shared.same[p] * num_ee + e];
+      for (GraspCandidate& c : dst) c.grasp.part = p;
+    }
+  }
+}
 
 // Grasp candidates per part and end effector, each checked against its own part.
 Result<SampledCandidates> SampleCandidates(const Project& project, const ProjectCheck& check,
@@ -204,7 +235,8 @@ Result<SampledCandidates> SampleCandidates(const Project& project, const Project
   X_AP.push_back(Iso3::Identity());
   // The collision world (FCL's trees, built serially) alongside the parts' raycasters.
   Result<detail::GripperCollision> world = Fail(ErrorCode::kInternal, "not built");
-  std::vector<std::unique_ptr<MeshQuery>> rays(num_parts);
+  std::vector<std::unique_ptr<MeshQuery>>& rays = sampled.rays;
+  rays.resize(num_parts);
   detail::ParallelFor(num_unique + 1, options.parallel, [&](int task) {
     if (task == 0) {
       world = detail::GripperCollision::Build(meshes, X_AP, effectors, ctx);
@@ -215,53 +247,84 @@ Result<SampledCandidates> SampleCandidates(const Project& project, const Project
   });
   if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp sampling"));
   if (!world) return Fail(world.error().code, "preprocess: " + world.error().message);
-  const int pool = std::max(out.grasps_per_set * std::max(1, options.candidate_factor), 8);
-  const int max_samples = pool * std::max(1, options.sample_factor);
+  sampled.pool = std::max(out.grasps_per_set * std::max(1, options.candidate_factor), 8);
+  sampled.max_samples = sampled.pool * std::max(1, options.sample_factor);
+  sampled.world = std::move(*world);
   std::vector<std::vector<GraspCandidate>>& candidates = sampled.candidates;
   candidates.resize(num_parts * num_ee);
   detail::ParallelFor(num_unique * num_ee, options.parallel, [&](int task) {
     const int p = shared.unique[task / num_ee], e = task % num_ee;
-    detail::GripperCollision local = *world;
+    detail::GripperCollision local = *sampled.world;
     const int only[1] = {p};
     local.EnableOnly(only);
     std::mt19937_64 rng(MixSeed(out.seed, static_cast<std::uint64_t>(task) + 1));
-    detail::SamplerInput in;
-    in.part = rays[p].get();
-    in.part_index = p;
-    in.X_AP = X_AP[p];
-    in.ee = &effectors[e];
-    in.ee_index = e;
-    in.friction = out.friction;
-    in.wanted = pool;
-    in.max_samples = max_samples;
-    std::vector<detail::GraspCandidate>& mine = candidates[p * num_ee + e];
-    if (effectors[e].kind == EndEffectorKind::kVacuum) {
-      mine = detail::SampleVacuum(in, options.vacuum, local, rng, ctx);
-      return;
+    const detail::SamplerInput in = SamplerInputFor(sampled, effectors, out, p, e);
+    candidates[p * num_ee + e] =
+        effectors[e].kind == EndEffectorKind::kVacuum
+            ? detail::SampleVacuum(in, options.vacuum, local, rng, ctx)
+            : detail::SampleTwoFinger(in, options.two_finger, local, rng, ctx);
+  });
+  if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp sampling"));
+  CopyToSharedMeshes(shared, num_ee, sampled);
+  return sampled;
+}
+
+// Whether part `p` needs reduced grasps for two-finger end effector `e`: its own subassembly's
+// full-pad candidates that clear the mating partner at the mating pose are fewer than
+// TwoFingerGraspOptions::reduced_below (a short collar, a button, a wheel whose rim the fingers
+// would enter). Parts with enough full-pad grasps get none: the reduced pass is most of
+// preprocessing's time where it runs.
+bool NeedsReducedGrasps(const Preprocessed& out, int p, int e, int below) {
+  for (const Subassembly& sub : out.subassemblies) {
+    if (sub.parts.size() != 1 || sub.parts.front() != p) continue;
+    const GraspSet& set = sub.grasp_sets[e];
+    return set.assembly_candidates_by_type[static_cast<int>(GraspType::kFullPad)] < below;
+  }
+  return false;
+}
+
+// Adds reduced (partial-pad, fingertip) candidates to the two-finger candidates of the parts
+// that need them (NeedsReducedGrasps; a part needs them when any part sharing its mesh does).
+// Returns the parts that got them.
+std::vector<char> AddReducedCandidates(const PreprocessOptions& options,
+                                       const std::vector<EndEffector>& effectors,
+                                       const SharedMeshes& shared, const Preprocessed& out,
+                                       SampledCandidates& sampled, const RunContext& ctx) {
+  const int num_parts = static_cast<int>(shared.same.size());
+  const int num_ee = static_cast<int>(effectors.size());
+  const int num_unique = static_cast<int>(shared.unique.size());
+  std::vector<char> needs(num_parts * num_ee, 0);
+  for (int p = 0; p < num_parts; ++p) {
+    for (int e = 0; e < num_ee; ++e) {
+      if (effectors[e].kind == EndEffectorKind::kTwoFinger &&
+          NeedsReducedGrasps(out, p, e, options.two_finger.reduced_below)) {
+        needs[shared.same[p] * num_ee + e] = 1;
+      }
     }
-    mine = detail::SampleTwoFinger(in, options.two_finger, local, rng, ctx);
-    if (!options.two_finger.reduced) return;
-    // Reduced grasps from a generator of their own: the full-pad candidates stay as they were.
-    std::mt19937_64 reduced_rng(
+  }
+  detail::ParallelFor(num_unique * num_ee, options.parallel, [&](int task) {
+    const int p = shared.unique[task / num_ee], e = task % num_ee;
+    if (!needs[p * num_ee + e] || ctx.ShouldStop()) return;
+    detail::GripperCollision local = *sampled.world;
+    const int only[1] = {p};
+    local.EnableOnly(only);
+    // A generator of their own: the full-pad candidates stay as they were.
+    std::mt19937_64 rng(
         MixSeed(out.seed, 0x9e3779b97f4a7c15ULL ^ (static_cast<std::uint64_t>(task) + 1)));
     // A larger pool: the features only reduced grasps hold are small (a collar, a button).
-    detail::SamplerInput reduced_in = in;
-    reduced_in.wanted = 4 * pool;
-    std::vector<detail::GraspCandidate> reduced =
-        detail::SampleTwoFingerReduced(reduced_in, options.two_finger, local, reduced_rng, ctx);
+    detail::SamplerInput in = SamplerInputFor(sampled, effectors, out, p, e);
+    in.wanted = 4 * sampled.pool;
+    std::vector<GraspCandidate> reduced =
+        detail::SampleTwoFingerReduced(in, options.two_finger, local, rng, ctx);
+    std::vector<GraspCandidate>& mine = sampled.candidates[p * num_ee + e];
     mine.insert(mine.end(), std::make_move_iterator(reduced.begin()),
                 std::make_move_iterator(reduced.end()));
   });
-  if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp sampling"));
   for (int p = 0; p < num_parts; ++p) {
-    if (shared.same[p] == p) continue;
-    for (int e = 0; e < num_ee; ++e) {
-      candidates[p * num_ee + e] = candidates[shared.same[p] * num_ee + e];
-      for (GraspCandidate& c : candidates[p * num_ee + e]) c.grasp.part = p;
-    }
+    for (int e = 0; e < num_ee; ++e) needs[p * num_ee + e] = needs[shared.same[p] * num_ee + e];
   }
-  sampled.world = std::move(*world);
-  return sampled;
+  CopyToSharedMeshes(shared, num_ee, sampled);
+  return needs;
 }
 
 // What the planner should know: subassemblies that cannot be set down or grasped.
@@ -346,16 +409,37 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
   const detail::SelectionScene scene = detail::BuildSelectionScene(
       project, check, out.subassemblies, sampled->X_AP, sampled->table_body);
   for (Subassembly& sub : out.subassemblies) sub.grasp_sets.resize(num_ee);
-  detail::ParallelFor(num_subs * num_ee, options.parallel, [&](int task) {
-    const int s = task / num_ee, e = task % num_ee;
-    Subassembly& sub = out.subassemblies[s];
-    std::optional<GraspSet> set =
-        detail::SelectGraspSet(sub, s, e, (*effectors)[e], sampled->candidates, num_ee, scene,
-                               *sampled->world, options, out.grasps_per_set, ctx);
-    if (set) sub.grasp_sets[e] = std::move(*set);
-  });
+  const auto select = [&](const std::vector<char>& which) {
+    detail::ParallelFor(num_subs * num_ee, options.parallel, [&](int task) {
+      const int s = task / num_ee, e = task % num_ee;
+      if (!which[task]) return;
+      Subassembly& sub = out.subassemblies[s];
+      std::optional<GraspSet> set =
+          detail::SelectGraspSet(sub, s, e, (*effectors)[e], sampled->candidates, num_ee, scene,
+                                 *sampled->world, options, out.grasps_per_set, ctx);
+      if (set) sub.grasp_sets[e] = std::move(*set);
+    });
+  };
+  select(std::vector<char>(num_subs * num_ee, 1));
   if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp selection"));
   lap("grasp_sets");
+
+  // Reduced grasps for the parts whose full-pad grasps leave too few that clear their partner;
+  // the sets of every subassembly holding such a part are selected again with them.
+  if (options.two_finger.reduced) {
+    const std::vector<char> needs =
+        AddReducedCandidates(options, *effectors, shared, out, *sampled, ctx);
+    if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "reduced grasp sampling"));
+    std::vector<char> again(num_subs * num_ee, 0);
+    for (int s = 0; s < num_subs; ++s) {
+      for (int p : out.subassemblies[s].parts) {
+        for (int e = 0; e < num_ee; ++e) again[s * num_ee + e] |= needs[p * num_ee + e];
+      }
+    }
+    select(again);
+    if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp selection"));
+    lap("reduced_grasps");
+  }
 
   AddWarnings(num_ee, out);
   lap.Total();

@@ -60,7 +60,8 @@ struct Preprocessed {
   double friction = 0.0;                   ///< Friction coefficient of the friction cone.
   std::uint64_t seed = 0;                  ///< Seed drawn from the run's generator.
   /// Wall-clock seconds per part of the stage: "subassemblies", "hulls", "placements",
-  /// "table_slots", "grasp_candidates", "grasp_sets", and "total" (the paper's t_grasp).
+  /// "table_slots", "grasp_candidates", "grasp_sets", "reduced_grasps" (the reduced pass and the
+  /// sets it changes), and "total" (the paper's t_grasp).
   StageTimes times;
   /// Things the planner should know, e.g. a subassembly that no end effector can grasp.
   std::vector<std::string> warnings;

@@ -128,6 +128,36 @@ TEST(GraspTypes, OnlyReducedGraspsHoldAShortCollarOnItsPlate) {
   for (const Grasp& g : SetOf(*pre2, "plate+collar").grasps) EXPECT_NE(g.part, 1);
 }
 
+// The reduced pass runs only for parts with too few full-pad grasps clear of their partner
+// (TwoFingerGraspOptions::reduced_below): the collar, not the plate, whose edges the fingers
+// clear around the collar.
+TEST(GraspTypes, OnlyPartsThatNeedThemGetReducedGrasps) {
+  const Scene s = CollarOnPlate();
+  const auto reduced_count = [](const GraspSet& set) {
+    return set.candidates_by_type[static_cast<int>(GraspType::kPartialPad)] +
+           set.candidates_by_type[static_cast<int>(GraspType::kFingertip)];
+  };
+  RunContext ctx(5);
+  auto pre = Preprocess(s.project, s.check, Quick(), ctx);
+  ASSERT_TRUE(pre) << pre.error().message;
+  EXPECT_GE(SetOf(*pre, "plate").assembly_candidates_by_type[0],
+            TwoFingerGraspOptions{}.reduced_below);
+  EXPECT_EQ(reduced_count(SetOf(*pre, "plate")), 0);
+  EXPECT_LT(SetOf(*pre, "collar").assembly_candidates_by_type[0],
+            TwoFingerGraspOptions{}.reduced_below);
+  EXPECT_GT(reduced_count(SetOf(*pre, "collar")), 0);
+
+  // reduced_below = 0: no part needs them.
+  PreprocessOptions never = Quick();
+  never.two_finger.reduced_below = 0;
+  RunContext ctx2(5);
+  auto none = Preprocess(s.project, s.check, never, ctx2);
+  ASSERT_TRUE(none) << none.error().message;
+  for (const std::string name : {"plate", "collar", "plate+collar"}) {
+    EXPECT_EQ(reduced_count(SetOf(*none, name)), 0) << name;
+  }
+}
+
 TEST(GraspTypes, FullPadGraspsComeFirstAndStayAsTheyWere) {
   const Scene s = CollarOnPlate();
   RunContext a_ctx(9), b_ctx(9);

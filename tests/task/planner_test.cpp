@@ -173,31 +173,11 @@ const std::vector<std::string> kExamplePlans = {
     "stool_step",
 #endif
     "chair", "cross", "cross_openarm", "cube", "cube_2x2x3", "fabrica_plumbers_block",
-    "fabrica_beam"};
+    "fabrica_beam", "fabrica_car"};
 // clang-format on
 
 INSTANTIATE_TEST_SUITE_P(Projects, ExamplePlan, ::testing::ValuesIn(kExamplePlans),
                          [](const auto& param_info) { return param_info.param; });
-
-// fabrica_car with its physical DAG (the wheels mate onto the body they touch, as the meshes
-// say) has no plan with today's grasps (issue 30: fingertip and partial-pad grips, on a branch,
-// plan it in ~60 s). Until then the planner must say where and why: the milestone that puts the
-// body onto a wheel, the gripper that hits the wheel at the mating pose, and the wheel that no
-// grasp takes from the table without the gripper entering it.
-TEST(WrapPlanInfeasible, FabricaCarPhysicalDagSaysWhereItFails) {
-  const fs::path file = ProjectFile("fabrica_car");
-  const LoadedProject lp = LoadProject(file);
-  if (!lp.ok()) GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, kNoTimeLimit, {});
-  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
-  const PlanStats& st = run.plan->stats;
-  ASSERT_FALSE(st.solved) << "fabrica_car plans now: put it back among the ExamplePlan projects";
-  EXPECT_NE(st.failure.find("'body+wheels0-3'"), std::string::npos) << st.failure;
-  EXPECT_NE(st.failure.find("hits 'wheel3' when mated"), std::string::npos) << st.failure;
-  EXPECT_NE(st.failure.find("gripper into the table"), std::string::npos) << st.failure;
-  ASSERT_TRUE(st.failure_detail.has_value());
-  EXPECT_EQ(st.failure_detail->stage, "task");
-}
 
 // When the backward abstraction cannot reach a step's assembly, WRAP says why at once instead of
 // searching: here wheel0 has lost every grasp (and the wrench model is off, so that the wrench
@@ -400,7 +380,9 @@ TEST(PlannerStats, WrenchCountersAddUp) {
   EXPECT_GT(st.lp_cache_hits, 0);
   EXPECT_LT(st.lp_cache_hits, st.lp_checks);
   EXPECT_GE(st.lp_solves, st.lp_checks - st.lp_cache_hits);
-  EXPECT_GE(st.lp_pivots, st.lp_solves) << "a load factor takes at least one pivot to raise";
+  // A vertex whose predecessor's final basis stays optimal takes no pivot (the planner's warm
+  // start), so pivots may be fewer than LPs; some LPs do pivot.
+  EXPECT_GT(st.lp_pivots, 0);
 }
 
 TEST(PlannerOptions, UnknownVariantIsRefused) {
