@@ -68,6 +68,10 @@ class DenseSimplex final : public LpBackend {
   bool SharedPhase1(int varying_column);
   // Saves the current basis as the start of every SolveWithColumn.
   void SaveStart();
+  // Back to the basis SaveStart saved (tableau, heads, values; not B^-1).
+  void RestoreStart();
+  // col_ = B^-1 * values with the current binv_: the varying column in the basis's terms.
+  void ColumnInBasis(const double* values);
   // The last solve's final basis with the varying column replaced by `col` (B^-1 of the new
   // values), its variable at its upper bound: kOptimal into `solution` when the basic values
   // stay within bounds, else kError and nothing changed.
@@ -481,6 +485,24 @@ void DenseSimplex::SaveStart() {
   crashed_ = true;
 }
 
+void DenseSimplex::RestoreStart() {
+  t_ = t0_;
+  head_ = head0_;
+  row_of_ = row_of0_;
+  xb_ = xb0_;
+  x_ = x0_;
+}
+
+void DenseSimplex::ColumnInBasis(const double* values) {
+  col_.resize(m_);
+  for (int r = 0; r < m_; ++r) {
+    const double* br = &binv_[static_cast<std::size_t>(r) * m_];
+    double v = 0.0;
+    for (int k = 0; k < m_; ++k) v += br[k] * values[k];
+    col_[r] = v;
+  }
+}
+
 bool DenseSimplex::SharedPhase1(int varying_column) {
   // The varying column held at 0: its tableau column zeroed, it never prices in nor blocks.
   for (int r = 0; r < m_; ++r) t_[static_cast<std::size_t>(r) * w_ + varying_column] = 0.0;
@@ -548,28 +570,13 @@ LpStatus DenseSimplex::SolveWithColumn(const double* values, LpSolution& solutio
   // B^-1 values, for the last basis (when it may serve) or the start basis.
   const bool try_last = last_at_bound_;
   if (!try_last) binv_ = binv0_;
-  col_.resize(m_);
-  for (int r = 0; r < m_; ++r) {
-    const double* br = &binv_[static_cast<std::size_t>(r) * m_];
-    double v = 0.0;
-    for (int k = 0; k < m_; ++k) v += br[k] * values[k];
-    col_[r] = v;
-  }
+  ColumnInBasis(values);
   if (try_last) {
     if (TryLastBasis(col_, solution) == LpStatus::kOptimal) return LpStatus::kOptimal;
     binv_ = binv0_;
-    for (int r = 0; r < m_; ++r) {
-      const double* br = &binv_[static_cast<std::size_t>(r) * m_];
-      double v = 0.0;
-      for (int k = 0; k < m_; ++k) v += br[k] * values[k];
-      col_[r] = v;
-    }
+    ColumnInBasis(values);
   }
-  t_ = t0_;
-  head_ = head0_;
-  row_of_ = row_of0_;
-  xb_ = xb0_;
-  x_ = x0_;
+  RestoreStart();
   iterations_ = pending_iterations_;
   pending_iterations_ = 0;
   for (int r = 0; r < m_; ++r) t_[static_cast<std::size_t>(r) * w_ + q] = col_[r];
