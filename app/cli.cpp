@@ -218,8 +218,10 @@ struct BenchCli {
     cmd->add_option("--suite", args.suite,
                     "paper (comparison, breakdown, convergence on cross, stool, chair), "
                     "fabrica, scaling (robots, wrench models, parts), ablation (wrench models "
-                    "simulated), all, smoke (every section once, small, on the cross: minutes) "
-                    "or tiny (the test suite's)");
+                    "simulated), makespan (plans with motion by default and with --optimize "
+                    "--objective makespan: makespan against one segment at a time), all, smoke "
+                    "(every section once, small, on the cross: minutes) or tiny (the test "
+                    "suite's)");
     cmd->add_option("--runs", args.runs, "Seeds per configuration (default 3)")
         ->check(CLI::PositiveNumber);
     time_option =

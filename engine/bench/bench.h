@@ -31,14 +31,18 @@ struct RunSpec {
   std::string wrench = "full";   ///< `--wrench full|gravity|none`.
   double force_scale = 1.0;      ///< `--force-scale` lambda.
   bool optimize = false;         ///< `--optimize`.
-  bool motion = false;           ///< Plan motion too (no `--task-only`).
-  bool sim = false;              ///< Then run `wrap sim` on the plan (needs motion).
-  std::uint64_t seed = 0;        ///< `--seed`.
-  double time_limit_s = 30.0;    ///< `--time-limit` given to the planner [s].
-  std::string group;             ///< Report section: comparison, breakdown, scaling_robots,
-                                 ///< scaling_parts, convergence, ablation, tiny.
+  /// `--objective`: "actions" (the planner's default: fewest actions) or "makespan" (the task
+  /// plan's makespan estimate, so that idle robots get work).
+  std::string objective = "actions";
+  bool motion = false;         ///< Plan motion too (no `--task-only`).
+  bool sim = false;            ///< Then run `wrap sim` on the plan (needs motion).
+  std::uint64_t seed = 0;      ///< `--seed`.
+  double time_limit_s = 30.0;  ///< `--time-limit` given to the planner [s].
+  std::string group;           ///< Report section: comparison, breakdown, scaling_robots,
+                               ///< scaling_parts, convergence, ablation, makespan, tiny.
 
-  /// The options as one CSV-safe string, e.g. "wrench=full;lambda=1;task-only".
+  /// The options as one CSV-safe string, e.g. "wrench=full;lambda=1;task-only". The objective
+  /// appears only when it is not "actions", so that the keys of earlier suites stay the same.
   std::string Options() const;
   /// A file-name-safe unique key: project, planner, options, seed.
   std::string Key() const;
@@ -77,7 +81,8 @@ struct RunResult {
   double cpu_s = 0.0;              ///< CPU time (user + system) of its children, plan and sim [s].
   double sim_wall_s = 0.0;         ///< Wall time of the sim child [s]; 0 when not simulated.
   /// The plan's stats by name (cost, first_cost, t_init_s, t_grasp_s, t_bwd_s, t_lp_s, t_fwd_s,
-  /// t_ik_s, t_kf_s, t_mp_s, t_retime_s, t_opt_s, makespan_s); absent where the plan gave none.
+  /// t_ik_s, t_kf_s, t_mp_s, t_retime_s, t_opt_s, makespan_s, makespan_sequential_s); absent
+  /// where the plan gave none.
   std::map<std::string, double> stats;
   std::vector<std::pair<double, double>> cost_history;  ///< (t [s], cost) after each improvement.
   std::optional<bool> sim_success;  ///< `wrap sim` verdict; absent when not simulated.
@@ -114,8 +119,8 @@ struct Progress {
 
 /// Options of a suite run.
 struct BenchOptions {
-  std::string suite = "paper";         ///< paper, fabrica, scaling, ablation, all, smoke, tiny.
-  int runs = 3;                        ///< Seeds 0..runs-1 per configuration.
+  std::string suite = "paper";  ///< paper, fabrica, scaling, ablation, makespan, all, smoke, tiny.
+  int runs = 3;                 ///< Seeds 0..runs-1 per configuration.
   std::optional<double> time_limit_s;  ///< Planner time limit; absent: each suite's default.
   int jobs = 0;                        ///< Runs at once; 0: the number of cores.
   int shard_index = 1;                 ///< This shard, 1..shard_count.
@@ -143,6 +148,13 @@ Result<std::vector<RunSpec>> MakeSuite(const BenchOptions& options);
 /// shards get a mix of sizes.
 std::vector<RunSpec> ShardSlice(const std::vector<RunSpec>& specs, int shard_index,
                                 int shard_count);
+
+/// The command line of a run's `wrap plan` child: `exe` plans `project_file` into `plan_file`
+/// with the spec's planner, seed, limits and options.
+std::vector<std::string> PlanArguments(const RunSpec& spec, const BenchOptions& options,
+                                       const std::filesystem::path& exe,
+                                       const std::filesystem::path& project_file,
+                                       const std::filesystem::path& plan_file);
 
 /// The longest a run can take [s]: the plan child's hard limit (BenchOptions::hard_limit_s, or
 /// the planner's limit plus max(10 s, half of it)), and four times that for `wrap sim` after it.

@@ -75,6 +75,7 @@ class ReportBuilder : public ReportBlocks {
     Convergence();
     Simulation();
     OwnMeasures(results_, *this);
+    MakespanObjective(results_, *this);
     Failures();
     return blocks();
   }

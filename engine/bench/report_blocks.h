@@ -69,4 +69,9 @@ std::vector<std::string> ProjectOrder(const std::set<std::string>& projects);
 /// success per assembly) from WRAP's runs with motion under the full wrench model.
 void OwnMeasures(const std::vector<RunResult>& results, ReportBlocks& report);
 
+/// The makespan suite's section (issue 33): per assembly and way of planning (default, or
+/// `--optimize --objective makespan`), the runs with motion, median / mean of makespan_s, of
+/// makespan_sequential_s and of their ratio, and the mean number of actions.
+void MakespanObjective(const std::vector<RunResult>& results, ReportBlocks& report);
+
 }  // namespace wrap::bench

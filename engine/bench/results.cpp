@@ -15,9 +15,13 @@ namespace {
 using Json = nlohmann::ordered_json;
 
 // The plan stats a run keeps, in the CSV's order.
-const std::vector<std::string> kStatColumns = {
-    "cost",   "first_cost", "t_init_s", "t_grasp_s",  "t_bwd_s", "t_lp_s",    "t_fwd_s",
-    "t_ik_s", "t_kf_s",     "t_mp_s",   "t_retime_s", "t_opt_s", "makespan_s"};
+const std::vector<std::string> kStatColumns = {"cost",       "first_cost",
+                                               "t_init_s",   "t_grasp_s",
+                                               "t_bwd_s",    "t_lp_s",
+                                               "t_fwd_s",    "t_ik_s",
+                                               "t_kf_s",     "t_mp_s",
+                                               "t_retime_s", "t_opt_s",
+                                               "makespan_s", "makespan_sequential_s"};
 
 const std::vector<std::string> kUtilColumns = {"transport_2f", "transport_vac", "insertion_2f",
                                                "insertion_vac"};
@@ -54,6 +58,7 @@ std::string RunResultToJson(const RunResult& r) {
   j["wrench"] = r.spec.wrench;
   j["force_scale"] = r.spec.force_scale;
   j["optimize"] = r.spec.optimize;
+  j["objective"] = r.spec.objective;
   j["motion"] = r.spec.motion;
   j["sim"] = r.spec.sim;
   j["seed"] = r.spec.seed;
@@ -113,6 +118,9 @@ Result<RunResult> RunResultFromJson(const std::string& text, const std::string& 
     r.spec.wrench = j.at("wrench").get<std::string>();
     r.spec.force_scale = j.at("force_scale").get<double>();
     r.spec.optimize = j.at("optimize").get<bool>();
+    // Files written before the objective was a setting were planned with the default.
+    r.spec.objective = j.value("objective", "actions");
+    if (r.spec.objective != "actions" && r.spec.objective != "makespan") return bad("objective");
     r.spec.motion = j.at("motion").get<bool>();
     r.spec.seed = j.at("seed").get<std::uint64_t>();
     r.spec.time_limit_s = j.at("time_limit_s").get<double>();

@@ -336,27 +336,8 @@ void SuiteRunner::Report(const RunResult& r, bool fresh) {
 }
 
 std::vector<std::string> SuiteRunner::PlanArgv(const Job& job) const {
-  const RunSpec& s = job.spec;
-  std::vector<std::string> a = {exe_.string(),
-                                "plan",
-                                job.project_file.string(),
-                                "--planner",
-                                s.planner,
-                                "--seed",
-                                std::to_string(s.seed),
-                                "--time-limit",
-                                Num(s.time_limit_s),
-                                "--wrench",
-                                s.wrench,
-                                "--force-scale",
-                                Num(s.force_scale),
-                                "--memory-limit",
-                                std::to_string(options_.memory_limit_mib),
-                                "-o",
-                                (out_ / "plans" / (job.key + ".json")).string()};
-  if (s.optimize) a.push_back("--optimize");
-  if (!s.motion) a.push_back("--task-only");
-  return a;
+  return PlanArguments(job.spec, options_, exe_, job.project_file,
+                       out_ / "plans" / (job.key + ".json"));
 }
 
 bool SuiteRunner::Start(Job& job) {
@@ -615,6 +596,37 @@ std::vector<RunSpec> ShardSlice(const std::vector<RunSpec>& specs, int shard_ind
     if (static_cast<int>(i % shard_count) == shard_index - 1) slice.push_back(specs[i]);
   }
   return slice;
+}
+
+std::vector<std::string> PlanArguments(const RunSpec& spec, const BenchOptions& options,
+                                       const fs::path& exe, const fs::path& project_file,
+                                       const fs::path& plan_file) {
+  std::vector<std::string> a = {exe.string(),
+                                "plan",
+                                project_file.string(),
+                                "--planner",
+                                spec.planner,
+                                "--seed",
+                                std::to_string(spec.seed),
+                                "--time-limit",
+                                Num(spec.time_limit_s),
+                                "--wrench",
+                                spec.wrench,
+                                "--force-scale",
+                                Num(spec.force_scale),
+                                "--memory-limit",
+                                std::to_string(options.memory_limit_mib),
+                                "-o",
+                                plan_file.string()};
+  if (spec.optimize) a.push_back("--optimize");
+  // The planner's own default when not given: the command lines of earlier suites stay as they
+  // were.
+  if (spec.objective != "actions") {
+    a.push_back("--objective");
+    a.push_back(spec.objective);
+  }
+  if (!spec.motion) a.push_back("--task-only");
+  return a;
 }
 
 double LongestRunS(const RunSpec& spec, const BenchOptions& options) {

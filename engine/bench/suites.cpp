@@ -164,12 +164,30 @@ void SmokeSuite(std::vector<RunSpec>& out, int runs, double task_limit, double m
   }
 }
 
+// Issue 33, cycle time: the plans with motion of every seed as planned by default and as
+// `--optimize --objective makespan` plans them, for makespan_s / makespan_sequential_s side by
+// side. The projects of BENCHMARKS.md's issue-33 motion table but the cube, whose makespan plans
+// all failed motion there.
+void MakespanSuite(std::vector<RunSpec>& out, int runs, double limit) {
+  for (const std::string p :
+       {"cross", "stool", "chair", "fabrica_beam", "fabrica_plumbers_block"}) {
+    RunSpec plain = Spec(Example(p, "makespan"), "wrap", "makespan", limit);
+    plain.motion = true;
+    AddSeeds(out, plain, runs);
+    RunSpec shortest = plain;
+    shortest.optimize = true;
+    shortest.objective = "makespan";
+    AddSeeds(out, shortest, runs);
+  }
+}
+
 }  // namespace
 
 std::string RunSpec::Options() const {
   std::string s = "wrench=" + wrench;
   if (wrench == "full") s += ";lambda=" + Num(force_scale);
   if (optimize) s += ";optimize";
+  if (objective != "actions") s += ";objective=" + objective;
   s += motion ? ";motion" : ";task-only";
   if (sim) s += ";sim";
   s += ";limit=" + Num(time_limit_s);
@@ -223,12 +241,12 @@ void SortResults(std::vector<RunResult>& results) {
 
 Result<std::vector<RunSpec>> MakeSuite(const BenchOptions& options) {
   if (options.runs < 1) return Fail(ErrorCode::kInvalidInput, "--runs: must be at least 1");
-  const std::set<std::string> known = {"paper", "fabrica", "scaling", "ablation",
-                                       "all",   "tiny",    "smoke"};
+  const std::set<std::string> known = {"paper",    "fabrica", "scaling", "ablation",
+                                       "makespan", "all",     "tiny",    "smoke"};
   if (!known.contains(options.suite)) {
     return Fail(ErrorCode::kInvalidInput,
                 "--suite: unknown suite '" + options.suite +
-                    "' (expected paper, fabrica, scaling, ablation, all, smoke or tiny)");
+                    "' (expected paper, fabrica, scaling, ablation, makespan, all, smoke or tiny)");
   }
   const auto limit = [&](double fallback) { return options.time_limit_s.value_or(fallback); };
   std::vector<RunSpec> specs;
@@ -246,6 +264,7 @@ Result<std::vector<RunSpec>> MakeSuite(const BenchOptions& options) {
   if (s == "fabrica" || s == "all") FabricaSuite(specs, options.runs, limit(30), limit(60));
   if (s == "scaling" || s == "all") ScalingSuite(specs, options.runs, limit(30));
   if (s == "ablation" || s == "all") AblationSuite(specs, options.runs, limit(60));
+  if (s == "makespan" || s == "all") MakespanSuite(specs, options.runs, limit(60));
   // Deterministic order, so that the i-th of N shards is the same slice on every machine.
   std::stable_sort(specs.begin(), specs.end(), [](const RunSpec& a, const RunSpec& b) {
     const auto ka = std::tie(a.project.name, a.planner);
