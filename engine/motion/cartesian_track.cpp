@@ -19,13 +19,13 @@ namespace wrap::detail {
 std::vector<std::vector<JointVector>> SegmentBuilder::Track(
     const std::vector<int>& robots, const std::vector<JointVector>& q0,
     const std::vector<std::function<Iso3(double)>>& targets, int steps,
-    const std::vector<JointVector>* goals) {
+    const std::vector<JointVector>* goals, double tolerance_m) {
   std::vector<std::vector<JointVector>> out(steps + 1, std::vector<JointVector>(robots.size()));
   NumericIkOptions ik;
   ik.restarts = 0;
   ik.max_iterations = 100;
-  ik.position_tolerance_m = 5e-4;  // within the validators' grasp tolerance (2 mm)
-  ik.rotation_tolerance_rad = 5e-3;
+  ik.position_tolerance_m = tolerance_m;
+  ik.rotation_tolerance_rad = 10.0 * tolerance_m;
   for (size_t i = 0; i < robots.size(); ++i) {
     const TaskRobot& r = w_.robots[robots[i]];
     JointVector q = q0[i];

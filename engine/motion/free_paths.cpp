@@ -216,6 +216,18 @@ PathAnswer SegmentBuilder::FreeQuery(const FreeRequest& req, const std::vector<i
   }
   query.stop = [this] { return ctx_.ShouldStop(); };
   query.shortcut_attempts = opt_.shortcut_attempts;
+  // Where the direct search fails, through the movers' home (the 7-DoF arms' starts and goals
+  // beside parts and other hands often both reach it while RRT-Connect's trees miss each other).
+  Eigen::VectorXd home(query.start.size());
+  bool homes = true;
+  for (size_t i = 0, o = 0; i < who.size() && homes; ++i) {
+    const JointVector& h = w_.robots[who[i]].home;
+    homes = h.size() == static_cast<long>(w_.robots[who[i]].chain.joints.size());
+    if (homes) home.segment(static_cast<long>(o), h.size()) = h;
+    o += static_cast<size_t>(h.size());
+  }
+  if (homes) query.via = {home};
+  query.via_name = who.size() == 1 ? "its home" : "their homes";
   const auto t_query = std::chrono::steady_clock::now();
   query.final_resolution = query.resolution / kRefine;
   const PathAnswer answer = PlanPath(query);

@@ -44,6 +44,12 @@ struct PathQuery {
   /// example projects got motion in 27 of 30 runs (seeds 0-2, 60 s), at 0.2 in 29, with the
   /// easy ones as fast as before.
   double range_per_sqrt_dim = 0.2;
+  /// Hubs: configurations (e.g. the robots' home) through which a path start -> hub -> goal is
+  /// searched when RRT-Connect finds no direct one within the budget, each leg within a quarter
+  /// of `max_checks` of its own, then shortcut as one path. Samples of a leg may reach beyond
+  /// `lower`/`upper` as far as its hub.
+  std::vector<Eigen::VectorXd> via;
+  std::string via_name = "the hub";  ///< The hubs in words, for `PathAnswer::why`.
 };
 
 /// What PlanPath found.
@@ -66,7 +72,8 @@ bool StraightMotionValid(const PathQuery& query, const Eigen::VectorXd& a, const
 /// (OMPL) within the work budget, then shortcutting (random pairs of points along the path joined
 /// by straight motions) and removal of waypoints whose neighbours see each other; every piece of
 /// the result is valid at `final_resolution` (RRT-Connect is run again with a new seed, within
-/// the budget, while its path is not). Deterministic for a given seed unless `stop` stops it.
+/// the budget, while its path is not); where that finds none within the budget, the same through
+/// each of `via` in turn. Deterministic for a given seed unless `stop` stops it.
 PathAnswer PlanPath(const PathQuery& query);
 
 }  // namespace wrap

@@ -28,6 +28,13 @@ namespace wrap::detail {
 // Largest joint jump between two IK samples of a straight move before it counts as a branch
 // switch (no straight move there) [rad].
 constexpr double kMaxTrackJump = 0.25;
+// How close a tracked straight move's samples come to their targets [m]: within the validators'
+// grasp tolerance (2 mm) for moves that carry, grasp or insert.
+constexpr double kTrackTolerance = 5e-4;
+// The same for a gripper backing away from what it let go of, or toward a grasp it has not
+// closed (BackOff) [m]: only its clearance matters there, which the tracked samples are checked
+// for. A 7-DoF arm at a joint limit tracks a line to about a millimetre, not half of one.
+constexpr double kLooseTrackTolerance = 3e-3;
 // A tracked straight move must end this close to its keyframe's joints [rad]; farther, it has
 // reached another IK solution of the same TCP pose, which replaces the keyframe's when valid.
 constexpr double kMaxSnap = 0.05;
@@ -185,11 +192,14 @@ class SegmentBuilder {
   // --- Straight TCP moves (cartesian_track.cpp).
   // Straight TCP moves of `robots` from `q0`: robot i's TCP follows targets[i](s), s in [0, 1],
   // in `steps` samples. Empty on failure (no IK, a branch jump).
-  // With `goals`, a redundant arm is pulled toward its goal joints along the way.
+  // With `goals`, a redundant arm is pulled toward its goal joints along the way. Each sample is
+  // within `tolerance_m` of its target (and a tenth of it in radians): a grasp, a lift or an
+  // insertion holds the validators' grasp tolerance; a gripper backing away from what it let go
+  // only needs to stay clear (BackOff).
   std::vector<std::vector<JointVector>> Track(
       const std::vector<int>& robots, const std::vector<JointVector>& q0,
       const std::vector<std::function<Iso3(double)>>& targets, int steps,
-      const std::vector<JointVector>* goals = nullptr);
+      const std::vector<JointVector>* goals = nullptr, double tolerance_m = kTrackTolerance);
   // One arm's path: the fewest of its samples (the first and the last kept) between which straight
   // joint motion stays within a fraction of a millimetre of every dropped sample's TCP pose: a
   // skill is timed piece by piece, each piece from rest to rest, so a line tracked at millimetres

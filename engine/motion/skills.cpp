@@ -32,7 +32,7 @@ std::vector<JointVector> SegmentBuilder::BackOff(
       X.translation() -= s * d * axis;
       return X;
     };
-    auto path = Track({robot}, {q}, {target}, steps);
+    auto path = Track({robot}, {q}, {target}, steps, nullptr, kLooseTrackTolerance);
     std::vector<JointVector> out;
     if (path.empty()) {
       last_hit_ = "no IK solution along the line";

@@ -125,6 +125,61 @@ TEST(OmplAdapter, OtherGoalsServeWhenTheGoalIsBlockedOrWalledIn) {
   EXPECT_TRUE(a.timed_out);
 }
 
+// The wall without its gap, up to y = 1, the top of the search box: no path within the box; a
+// hub above the wall (y = 1.3) widens the legs' boxes so that they reach around it.
+PathQuery WallWithoutGapQuery() {
+  PathQuery q = WallQuery();
+  q.valid = [](const Eigen::VectorXd& x) { return x[0] < 0.45 || x[0] > 0.55 || x[1] > 1.0; };
+  q.max_checks = 20000;
+  q.via = {Eigen::Vector2d(0.5, 1.3)};
+  q.via_name = "the point above the wall";
+  return q;
+}
+
+TEST(OmplAdapter, AHubJoinsAStartAndAGoalTheSearchCannotJoin) {
+  const PathQuery q = WallWithoutGapQuery();
+  PathQuery direct = q;
+  direct.via.clear();
+  const PathAnswer none = PlanPath(direct);
+  ASSERT_FALSE(none.solved);
+  EXPECT_TRUE(none.timed_out);
+  const PathAnswer a = PlanPath(q);
+  ASSERT_TRUE(a.solved) << a.why;
+  EXPECT_EQ(a.goal_index, 0);
+  EXPECT_TRUE(a.path.front().isApprox(q.start));
+  EXPECT_TRUE(a.path.back().isApprox(q.goal));
+  // Over the wall (beyond the query's box, within the legs' boxes), every piece free.
+  double top = 0.0;
+  for (size_t i = 1; i < a.path.size(); ++i) {
+    EXPECT_TRUE(StraightMotionValid(q, a.path[i - 1], a.path[i])) << "piece " << i;
+    top = std::max(top, a.path[i][1]);
+  }
+  EXPECT_GT(top, 1.0);
+  EXPECT_GT(a.checks, none.checks);  // the direct search's budget, then the legs'
+  const PathAnswer b = PlanPath(q);
+  ASSERT_TRUE(b.solved);
+  ASSERT_EQ(a.path.size(), b.path.size());
+  for (size_t i = 0; i < a.path.size(); ++i) EXPECT_EQ(a.path[i], b.path[i]);
+}
+
+TEST(OmplAdapter, ABlockedHubIsNamedInTheAnswer) {
+  PathQuery q = WallWithoutGapQuery();
+  q.via = {Eigen::Vector2d(0.5, 0.5)};  // inside the wall
+  q.via_name = "the point in the wall";
+  const PathAnswer a = PlanPath(q);
+  EXPECT_FALSE(a.solved);
+  EXPECT_TRUE(a.timed_out);
+  EXPECT_NE(a.why.find("nor through the point in the wall"), std::string::npos) << a.why;
+  // A stop requested ends the search before the hub's legs run.
+  int calls = 0;
+  q.via = {Eigen::Vector2d(0.5, 1.3)};
+  q.stop = [&calls] { return ++calls > 3; };
+  q.max_checks = 1LL << 40;
+  const PathAnswer s = PlanPath(q);
+  EXPECT_FALSE(s.solved);
+  EXPECT_FALSE(s.timed_out);
+}
+
 TEST(OmplAdapter, NoPathTimesOutAndStopsOnRequest) {
   PathQuery q = WallQuery();
   q.valid = [](const Eigen::VectorXd& x) { return x[0] < 0.45 || x[0] > 0.55; };  // no gap
