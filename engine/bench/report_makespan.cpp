@@ -3,6 +3,10 @@
 // at work together beside the same segments one at a time, and the ratio of the two.
 #include <algorithm>
 #include <map>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "bench/paper_numbers.h"
 #include "bench/report_blocks.h"

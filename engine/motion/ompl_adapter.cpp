@@ -5,7 +5,9 @@
 #include <cmath>
 #include <memory>
 #include <random>
-
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <ompl/base/MotionValidator.h>
 #include <ompl/base/ProblemDefinition.h>

@@ -4,9 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <fstream>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "bench/bench.h"
 #include "bench/child_output.h"
@@ -144,9 +149,8 @@ TEST(BenchObjective, MakespanSuitePlansEverySeedThreeWays) {
                                 std::to_string(s.seed));
     EXPECT_TRUE(fs::exists(ProjectsDir() / (s.project.base + ".json"))) << s.project.base;
   }
-  const std::set<std::string> three = {"actions/0",          "actions/1",
-                                       "makespan/0",         "makespan/1",
-                                       "optimize makespan/0", "optimize makespan/1"};
+  const std::set<std::string> three = {"actions/0",  "actions/1",           "makespan/0",
+                                       "makespan/1", "optimize makespan/0", "optimize makespan/1"};
   for (const char* p : {"cross", "stool", "chair", "fabrica_beam", "fabrica_plumbers_block"}) {
     EXPECT_EQ(ways[p], three) << p;
   }
