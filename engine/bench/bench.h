@@ -188,6 +188,9 @@ Result<std::vector<RunResult>> ReadRunResults(const std::vector<std::filesystem:
 Result<std::vector<RunResult>> MergeShards(const std::vector<std::filesystem::path>& dirs,
                                            const std::filesystem::path& out, bool partial = false);
 
+/// The plan stats a run keeps (read from the plan file's `stats`), in results.csv's column order.
+const std::vector<std::string>& PlanStatKeys();
+
 /// Sorts results by project, planner, options, seed.
 void SortResults(std::vector<RunResult>& results);
 

@@ -15,14 +15,6 @@ namespace {
 
 using Json = nlohmann::json;
 
-const std::vector<std::string> kStats = {"cost",       "first_cost",
-                                         "t_init_s",   "t_grasp_s",
-                                         "t_bwd_s",    "t_lp_s",
-                                         "t_fwd_s",    "t_ik_s",
-                                         "t_kf_s",     "t_mp_s",
-                                         "t_retime_s", "t_opt_s",
-                                         "makespan_s", "makespan_sequential_s"};
-
 using Intervals = std::vector<std::pair<double, double>>;
 
 // Sorted, disjoint intervals covering the same time as `v`.
@@ -101,7 +93,7 @@ PlanOutcome ReadPlanFile(RunResult& r, const std::filesystem::path& plan_file) {
   const Json& st = j["stats"];
   const bool solved = st.value("solved", false);
   const bool motion = st.value("motion", false);
-  for (const std::string& k : kStats) {
+  for (const std::string& k : PlanStatKeys()) {
     if (!st.contains(k) || !st[k].is_number()) continue;
     // Cost and its history mean nothing without a plan; the times do.
     const bool makespan = k == "makespan_s" || k == "makespan_sequential_s";

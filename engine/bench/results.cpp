@@ -14,15 +14,6 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-// The plan stats a run keeps, in the CSV's order.
-const std::vector<std::string> kStatColumns = {"cost",       "first_cost",
-                                               "t_init_s",   "t_grasp_s",
-                                               "t_bwd_s",    "t_lp_s",
-                                               "t_fwd_s",    "t_ik_s",
-                                               "t_kf_s",     "t_mp_s",
-                                               "t_retime_s", "t_opt_s",
-                                               "makespan_s", "makespan_sequential_s"};
-
 const std::vector<std::string> kUtilColumns = {"transport_2f", "transport_vac", "insertion_2f",
                                                "insertion_vac"};
 
@@ -44,6 +35,17 @@ std::string CsvField(const std::string& s) {
 }
 
 }  // namespace
+
+const std::vector<std::string>& PlanStatKeys() {
+  static const std::vector<std::string> keys = {"cost",       "first_cost",
+                                                "t_init_s",   "t_grasp_s",
+                                                "t_bwd_s",    "t_lp_s",
+                                                "t_fwd_s",    "t_ik_s",
+                                                "t_kf_s",     "t_mp_s",
+                                                "t_retime_s", "t_opt_s",
+                                                "makespan_s", "makespan_sequential_s"};
+  return keys;
+}
 
 std::string RunResultToJson(const RunResult& r) {
   Json j;
@@ -171,14 +173,14 @@ Result<RunResult> RunResultFromJson(const std::string& text, const std::string& 
 std::string ResultsCsv(const std::vector<RunResult>& results) {
   std::ostringstream s;
   s << "project,planner,options,seed,status,solved";
-  for (const std::string& c : kStatColumns) s << "," << c;
+  for (const std::string& c : PlanStatKeys()) s << "," << c;
   s << ",peak_rss_mib,wall_s,cpu_s,sim_wall_s,exit_code,signal,sim_success,sim_tasks,sim_failure";
   for (const std::string& c : kUtilColumns) s << ",sim_util_" << c;
   s << ",robots_moving_percent,moving_profile,load,cores,loaded,host,cost_history,group,message\n";
   for (const RunResult& r : results) {
     s << CsvField(r.spec.project.name) << "," << r.spec.planner << "," << r.spec.Options() << ","
       << r.spec.seed << "," << ToString(r.status) << "," << (r.solved() ? 1 : 0);
-    for (const std::string& c : kStatColumns) {
+    for (const std::string& c : PlanStatKeys()) {
       s << ",";
       if (auto it = r.stats.find(c); it != r.stats.end()) s << Num(it->second);
     }
