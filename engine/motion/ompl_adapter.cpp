@@ -314,9 +314,11 @@ constexpr long long kHubLegShare = 4;
 // grown from the pockets miss each other.
 void ConnectViaHubs(const PathQuery& query, PathAnswer& out) {
   const bool stopped_before = query.stop && query.stop();
+  bool tried = false;
   for (size_t h = 0; h < query.via.size() && !stopped_before; ++h) {
     const Eigen::VectorXd& hub = query.via[h];
-    if (Same(hub, query.start) || Same(hub, query.goal)) continue;
+    if (Same(hub, query.start) || Same(hub, query.goal)) continue;  // the direct search again
+    tried = true;
     PathQuery leg = query;
     leg.via.clear();
     leg.lower = query.lower.cwiseMin(hub);
@@ -350,7 +352,7 @@ void ConnectViaHubs(const PathQuery& query, PathAnswer& out) {
     out.why.clear();
     return;
   }
-  if (!query.via.empty() && out.timed_out) out.why += ", nor through " + query.via_name;
+  if (tried && out.timed_out) out.why += ", nor through " + query.via_name;
 }
 
 }  // namespace
