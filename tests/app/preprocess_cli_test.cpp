@@ -1,10 +1,12 @@
 // `wrap preprocess`: exit codes, the printed summary and the JSON it writes.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
 
 #include "cli_runner.h"
 
@@ -14,7 +16,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir() {
-  const fs::path dir = fs::temp_directory_path() / "wrap_preprocess_cli_test";
+  const fs::path dir =
+      fs::temp_directory_path() / ("wrap_preprocess_cli_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir;
 }

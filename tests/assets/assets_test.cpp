@@ -2,6 +2,7 @@
 // byte, every mesh is a closed solid, and every designed peg fits its pocket.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -140,7 +141,8 @@ bool IsEmpty(const Aabb& b) { return (b.max.array() <= b.min.array()).any(); }
 
 TEST(AssetsTest, CommittedMeshesMatchTheGenerator) {
   ASSERT_FALSE(Parts().empty());
-  const fs::path out = fs::path(::testing::TempDir()) / "wrap_assets_test_parts";
+  const fs::path out =
+      fs::path(::testing::TempDir()) / ("wrap_assets_test_parts_" + std::to_string(::getpid()));
   fs::remove_all(out);
   std::set<fs::path> generated;
   for (const GeneratedPart& part : Parts()) {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <string>
 
@@ -17,7 +18,10 @@ inline std::filesystem::path ExampleProject(const std::string& name) {
 
 /// A fresh empty folder for one test (under the test's temporary folder).
 inline std::filesystem::path ScratchDir(const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "wrap_gui" / name;
+  // Per process: two test runs on one machine (two checkouts, ctest beside a CI job) must not
+  // clear each other's folders mid-test.
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) /
+                                    ("wrap_gui_" + std::to_string(::getpid())) / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
