@@ -1,10 +1,12 @@
 // The CLI contract: exit codes, messages on stderr naming file, field and problem.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <string>
 
 #include "cli_runner.h"
 
@@ -14,7 +16,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempFile(const std::string& name, const std::string& contents) {
-  const fs::path dir = fs::temp_directory_path() / "wrap_cli_test";
+  const fs::path dir = fs::temp_directory_path() / ("wrap_cli_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path f = dir / name;
   std::ofstream(f, std::ios::binary) << contents;

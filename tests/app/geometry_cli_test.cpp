@@ -2,10 +2,12 @@
 // impossible, wrap info prints the contact graph, and every example project passes.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "cli_runner.h"
 #include "geometry/mesh_export.h"
@@ -20,7 +22,8 @@ using nlohmann::json;
 // by `edit`.
 fs::path Variant(const std::string& name, const std::string& tag,
                  const std::function<void(json&)>& edit) {
-  const fs::path dir = fs::temp_directory_path() / ("wrap_geometry_cli_" + tag);
+  const fs::path dir =
+      fs::temp_directory_path() / ("wrap_geometry_cli_" + std::to_string(::getpid()) + "_" + tag);
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ifstream in(Project(name));
@@ -96,11 +99,13 @@ TEST(GeometryCli, InfoPrintsTheContactGraphAndInsertionPaths) {
 // (the plate is wider than the stroke across its face), so no grasp clears the table: a warning
 // that says so, by the planner's own pick checks.
 TEST(GeometryCli, PartThatNoGraspCanTakeFromTheTableIsAWarning) {
-  const fs::path dir = fs::temp_directory_path() / "wrap_geometry_cli_plate";
+  const fs::path dir =
+      fs::temp_directory_path() / ("wrap_geometry_cli_plate_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   ASSERT_TRUE(WriteStl(dir / "block.stl", BoxMesh(Vec3(-0.03, -0.03, 0), Vec3(0.03, 0.03, 0.04))));
-  ASSERT_TRUE(WriteStl(dir / "plate.stl", BoxMesh(Vec3(-0.05, -0.05, 0.04), Vec3(0.05, 0.05, 0.042))));
+  ASSERT_TRUE(
+      WriteStl(dir / "plate.stl", BoxMesh(Vec3(-0.05, -0.05, 0.04), Vec3(0.05, 0.05, 0.042))));
   const json project = json::parse(R"({
     "format": "wrap-project", "version": 1, "name": "plate",
     "parts": [
@@ -118,9 +123,10 @@ TEST(GeometryCli, PartThatNoGraspCanTakeFromTheTableIsAWarning) {
   std::ofstream(dir / "plate.json") << project.dump(2);
   const CliRun v = Wrap({"validate", (dir / "plate.json").string()});
   EXPECT_EQ(v.code, 0) << v.err;  // a warning, not an error
-  EXPECT_NE(v.err.find("part 'plate', initial_pose: warning: no grasp of 'plate' can be taken where it "
-                       "rests (every one of the"),
-            std::string::npos)
+  EXPECT_NE(
+      v.err.find("part 'plate', initial_pose: warning: no grasp of 'plate' can be taken where it "
+                 "rests (every one of the"),
+      std::string::npos)
       << v.err;
   EXPECT_NE(v.err.find("gripper into the table)"), std::string::npos) << v.err;
   EXPECT_EQ(v.err.find("'block' can be taken"), std::string::npos) << v.err;

@@ -1,9 +1,11 @@
 // `wrap plan` through the CLI: the contract's exit codes, the words it prints and the plan file.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "cli_runner.h"
 
@@ -13,7 +15,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("wrap_plan_cli_" + name);
+  const fs::path dir =
+      fs::temp_directory_path() / ("wrap_plan_cli_" + std::to_string(::getpid()) + "_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

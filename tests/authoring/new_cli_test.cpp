@@ -3,8 +3,10 @@
 // Fabrica folders validate cleanly and plan.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include "../app/cli_runner.h"
 #include "geometry/mesh_export.h"
@@ -19,7 +21,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("wrap_new_cli_" + name);
+  const fs::path dir =
+      fs::temp_directory_path() / ("wrap_new_cli_" + std::to_string(::getpid()) + "_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -1,6 +1,7 @@
 // Project format: round trip, every validation rule with a broken fixture, the example projects.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -42,8 +43,8 @@ class ProjectFixture : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           (std::string("wrap_model_test_") + info->test_suite_name() + "_" + info->name());
+    dir_ = fs::temp_directory_path() / ("wrap_model_test_" + std::to_string(::getpid()) + "_" +
+                                        info->test_suite_name() + "_" + info->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_ / "meshes");
     ASSERT_TRUE(WriteObj(dir_ / "meshes" / "cube.obj", Box(Vec3(40, 40, 40)), 1.0));

@@ -2,8 +2,10 @@
 // and mocap parts it should, and MuJoCo's kinematics agree with ours.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <numbers>
+#include <string>
 
 #include "geometry/step_import.h"
 #include "robot/home.h"
@@ -187,7 +189,7 @@ TEST(Mjcf, WrittenFilesLoadFromDisk) {
   const Loaded l = Load("stool");
   auto doc = BuildCellMjcf(l.scene, InitialState(l.scene));
   ASSERT_TRUE(doc.has_value());
-  const fs::path dir = fs::temp_directory_path() / "wrap_mjcf_test";
+  const fs::path dir = fs::temp_directory_path() / ("wrap_mjcf_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   ASSERT_TRUE(WriteMjcf(*doc, dir).has_value());
   InstallMujocoHandlers();
