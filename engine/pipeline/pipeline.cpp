@@ -273,11 +273,13 @@ Plan MotionQueue::Unsolved() {
   Plan plan = std::move(*fallback_);
   plan.stats.solved = false;
   StampStats(plan);
-  plan.stats.failure = "no motion for the task plan" + std::string(made_ > 1 ? "s" : "") +
-                       " found (" + std::to_string(made_) + " tried" +
-                       (ctx_.timed_out() ? ", time limit reached before the work budgets were spent"
-                                         : ", work budgets spent; --budget gives more") +
-                       "); last: " + (last_failure_.empty() ? "none planned" : last_failure_);
+  plan.stats.failure =
+      "no motion for the task plan" + std::string(made_ > 1 ? "s" : "") + " found (" +
+      std::to_string(made_) + " tried" +
+      (ctx_.timed_out() ? ", time limit reached before the work budgets were spent; "
+                          "a longer time limit lets the search go on"
+                        : ", work budgets spent; --budget gives more") +
+      "); last: " + (last_failure_.empty() ? "none planned" : last_failure_);
   if (last_detail_) {
     last_detail_->text = plan.stats.failure;
     plan.stats.failure_detail = std::move(last_detail_);
