@@ -109,9 +109,12 @@ struct TwoFingerGraspOptions {
   /// each set after them (so the planner's widening reaches them last). Default true.
   bool reduced = true;
   /// ... for the parts that need them: those whose own full-pad candidates that clear the
-  /// mating partner at the mating pose number fewer than this (a wheel, a short collar, a
-  /// button). 0: none; a large number: every part. Default 4.
-  int reduced_below = 4;
+  /// mating partner at the mating pose number fewer than this share of the grasp set (a wheel,
+  /// a short collar, a button, a slide that leaves the gripper little room). 0: none; 1 or more:
+  /// every part whose full-pad assembly grasps cannot fill the set. Default 0.25 (16 of 64): with
+  /// fewer, the few that clear the partner rarely also reach from the table and leave IK room
+  /// at the mating pose (the gamepad's slide: 4-10 of 256, task plans for 1 seed of 3).
+  double reduced_below_share = 0.25;
   /// Least contact of a reduced grasp on each pad [m^2]. Default 0.2 cm^2: a patch of about
   /// 4.5 x 4.5 mm, at least two cells of the reduced pass's pad grid; below it the pad meets
   /// an edge or a point, where no contact patch (and no torque capacity) can be relied on.
@@ -123,6 +126,10 @@ struct TwoFingerGraspOptions {
   int reduced_rays_width = 8;
   int reduced_rays_length = 8;
 };
+
+/// How many full-pad assembly candidates a part needs to go without reduced grasps, for sets of
+/// `grasps_per_set` (TwoFingerGraspOptions::reduced_below_share of it, rounded up; 0 for none).
+int ReducedGraspThreshold(const TwoFingerGraspOptions& options, int grasps_per_set);
 
 /// Options of the vacuum sampler.
 struct VacuumGraspOptions {

@@ -26,6 +26,12 @@ namespace {
 using detail::GraspCandidate;
 using Clock = std::chrono::steady_clock;
 
+// A part with reduced grasps and fewer than this many candidates (of any type) clear of its
+// partner at the mating pose draws reduced candidates a second time, kShortPoolFactor times the
+// full-pad pool (4 times round 0's samples).
+constexpr int kLeastAssemblyGrasps = 8;
+constexpr int kShortPoolFactor = 16;
+
 // SplitMix64 of a and b: independent seeds for the tasks of one run.
 std::uint64_t MixSeed(std::uint64_t a, std::uint64_t b) {
   std::uint64_t z = a + 0x9E3779B97F4A7C15ull * (b + 1);
@@ -271,7 +277,7 @@ Result<SampledCandidates> SampleCandidates(const Project& project, const Project
 
 // Whether part `p` needs reduced grasps for two-finger end effector `e`: its own subassembly's
 // full-pad candidates that clear the mating partner at the mating pose are fewer than
-// TwoFingerGraspOptions::reduced_below (a short collar, a button, a wheel whose rim the fingers
+// ReducedGraspThreshold (a short collar, a button, a wheel whose rim the fingers
 // would enter). Parts with enough full-pad grasps get none: the reduced pass is most of
 // preprocessing's time where it runs.
 bool NeedsReducedGrasps(const Preprocessed& out, int p, int e, int below) {
@@ -283,37 +289,69 @@ bool NeedsReducedGrasps(const Preprocessed& out, int p, int e, int below) {
   return false;
 }
 
-// Adds reduced (partial-pad, fingertip) candidates to the two-finger candidates of the parts
-// that need them (NeedsReducedGrasps; a part needs them when any part sharing its mesh does).
-// Returns the parts that got them.
+// Whether part `p` is still short of assembly grasps for end effector `e` after its reduced
+// grasps were added: fewer than `least` of its candidates of any type clear its partner at the
+// mating pose (a pipe whose collar fingertips reach from above only where the elbow fits between
+// the fingers: 0-6 of ~1000 reduced candidates, depending on the seed).
+bool ShortOfAssemblyGrasps(const Preprocessed& out, int p, int e, int least) {
+  for (const Subassembly& sub : out.subassemblies) {
+    if (sub.parts.size() != 1 || sub.parts.front() != p) continue;
+    const auto& by_type = sub.grasp_sets[e].assembly_candidates_by_type;
+    return by_type[0] + by_type[1] + by_type[2] < least;
+  }
+  return false;
+}
+
+// The parts (index part * num_ee + end effector) whose two-finger candidates get reduced ones
+// in round `round`: 0, the parts that need them (NeedsReducedGrasps); 1, those of them still
+// short of assembly grasps (ShortOfAssemblyGrasps). A part needs them when any part sharing its
+// mesh does; the mask is set on the mesh's unique part.
+std::vector<char> ReducedRoundParts(const PreprocessOptions& options,
+                                    const std::vector<EndEffector>& effectors,
+                                    const SharedMeshes& shared, const Preprocessed& out,
+                                    const std::vector<char>& before, int round) {
+  const int num_parts = static_cast<int>(shared.same.size());
+  const int num_ee = static_cast<int>(effectors.size());
+  const int threshold = ReducedGraspThreshold(options.two_finger, out.grasps_per_set);
+  std::vector<char> needs(num_parts * num_ee, 0);
+  for (int p = 0; p < num_parts; ++p) {
+    for (int e = 0; e < num_ee; ++e) {
+      if (effectors[e].kind != EndEffectorKind::kTwoFinger) continue;
+      const bool take = round == 0 ? NeedsReducedGrasps(out, p, e, threshold)
+                                   : before[p * num_ee + e] &&
+                                         ShortOfAssemblyGrasps(out, p, e, kLeastAssemblyGrasps);
+      if (take) needs[shared.same[p] * num_ee + e] = 1;
+    }
+  }
+  return needs;
+}
+
+// Adds reduced (partial-pad, fingertip) candidates to the two-finger candidates of the unique
+// parts marked in `needs` (ReducedRoundParts), with a generator of each round's own and a pool
+// of 4 times the full-pad one in round 0, kShortPoolFactor times it in round 1. Returns the
+// parts that got them (every part sharing a marked mesh).
 std::vector<char> AddReducedCandidates(const PreprocessOptions& options,
                                        const std::vector<EndEffector>& effectors,
                                        const SharedMeshes& shared, const Preprocessed& out,
+                                       std::vector<char> needs, int round,
                                        SampledCandidates& sampled, const RunContext& ctx) {
   const int num_parts = static_cast<int>(shared.same.size());
   const int num_ee = static_cast<int>(effectors.size());
   const int num_unique = static_cast<int>(shared.unique.size());
-  std::vector<char> needs(num_parts * num_ee, 0);
-  for (int p = 0; p < num_parts; ++p) {
-    for (int e = 0; e < num_ee; ++e) {
-      if (effectors[e].kind == EndEffectorKind::kTwoFinger &&
-          NeedsReducedGrasps(out, p, e, options.two_finger.reduced_below)) {
-        needs[shared.same[p] * num_ee + e] = 1;
-      }
-    }
-  }
   detail::ParallelFor(num_unique * num_ee, options.parallel, [&](int task) {
     const int p = shared.unique[task / num_ee], e = task % num_ee;
     if (!needs[p * num_ee + e] || ctx.ShouldStop()) return;
     detail::GripperCollision local = *sampled.world;
     const int only[1] = {p};
     local.EnableOnly(only);
-    // A generator of their own: the full-pad candidates stay as they were.
-    std::mt19937_64 rng(
-        MixSeed(out.seed, 0x9e3779b97f4a7c15ULL ^ (static_cast<std::uint64_t>(task) + 1)));
+    // A generator of their own: the full-pad candidates (and round 0's) stay as they were.
+    const std::uint64_t salt = round == 0 ? 0x9e3779b97f4a7c15ULL : 0xc2b2ae3d27d4eb4fULL;
+    std::mt19937_64 rng(MixSeed(out.seed, salt ^ (static_cast<std::uint64_t>(task) + 1)));
     // A larger pool: the features only reduced grasps hold are small (a collar, a button).
+    const int factor = round == 0 ? 4 : kShortPoolFactor;
     detail::SamplerInput in = SamplerInputFor(sampled, effectors, out, p, e);
-    in.wanted = 4 * sampled.pool;
+    in.wanted = factor * sampled.pool;
+    in.max_samples = factor / 4 * sampled.max_samples;
     std::vector<GraspCandidate> reduced =
         detail::SampleTwoFingerReduced(in, options.two_finger, local, rng, ctx);
     std::vector<GraspCandidate>& mine = sampled.candidates[p * num_ee + e];
@@ -425,19 +463,26 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
   lap("grasp_sets");
 
   // Reduced grasps for the parts whose full-pad grasps leave too few that clear their partner;
-  // the sets of every subassembly holding such a part are selected again with them.
+  // the sets of every subassembly holding such a part are selected again with them. A part
+  // still short of assembly grasps after that draws again from a pool four times as large.
   if (options.two_finger.reduced) {
-    const std::vector<char> needs =
-        AddReducedCandidates(options, *effectors, shared, out, *sampled, ctx);
-    if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "reduced grasp sampling"));
-    std::vector<char> again(num_subs * num_ee, 0);
-    for (int s = 0; s < num_subs; ++s) {
-      for (int p : out.subassemblies[s].parts) {
-        for (int e = 0; e < num_ee; ++e) again[s * num_ee + e] |= needs[p * num_ee + e];
+    std::vector<char> got(num_parts * num_ee, 0);
+    for (int round = 0; round < 2; ++round) {
+      std::vector<char> needs = ReducedRoundParts(options, *effectors, shared, out, got, round);
+      if (std::ranges::none_of(needs, [](char c) { return c != 0; })) break;
+      needs = AddReducedCandidates(options, *effectors, shared, out, std::move(needs), round,
+                                   *sampled, ctx);
+      if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "reduced grasp sampling"));
+      std::vector<char> again(num_subs * num_ee, 0);
+      for (int s = 0; s < num_subs; ++s) {
+        for (int p : out.subassemblies[s].parts) {
+          for (int e = 0; e < num_ee; ++e) again[s * num_ee + e] |= needs[p * num_ee + e];
+        }
       }
+      for (size_t k = 0; k < got.size(); ++k) got[k] |= needs[k];
+      select(again);
+      if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp selection"));
     }
-    select(again);
-    if (ctx.ShouldStop()) return std::unexpected(Stopped(ctx, "grasp selection"));
     lap("reduced_grasps");
   }
 
@@ -447,6 +492,11 @@ Result<Preprocessed> Run(const Project& project, const ProjectCheck& check,
 }
 
 }  // namespace
+
+int ReducedGraspThreshold(const TwoFingerGraspOptions& options, int grasps_per_set) {
+  if (options.reduced_below_share <= 0.0) return 0;
+  return static_cast<int>(std::ceil(options.reduced_below_share * grasps_per_set));
+}
 
 const Subassembly* Preprocessed::Find(const std::string& name) const {
   for (const Subassembly& s : subassemblies) {

@@ -156,7 +156,8 @@ TEST_P(ExampleGeometry, ValidatesWithoutWarnings) {
 INSTANTIATE_TEST_SUITE_P(Examples, ExampleGeometry,
                          ::testing::Values("stool", "half_stool", "chair", "cross", "cross_openarm",
                                            "cube", "cube_2x2x3", "fabrica_beam",
-                                           "fabrica_plumbers_block", "fabrica_car"),
+                                           "fabrica_plumbers_block", "fabrica_car", "fabrica_gamepad",
+                                           "fabrica_cooling_manifold"),
                          [](const auto& param_info) { return param_info.param; });
 
 }  // namespace

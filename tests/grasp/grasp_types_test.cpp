@@ -129,7 +129,7 @@ TEST(GraspTypes, OnlyReducedGraspsHoldAShortCollarOnItsPlate) {
 }
 
 // The reduced pass runs only for parts with too few full-pad grasps clear of their partner
-// (TwoFingerGraspOptions::reduced_below): the collar, not the plate, whose edges the fingers
+// (ReducedGraspThreshold): the collar, not the plate, whose edges the fingers
 // clear around the collar.
 TEST(GraspTypes, OnlyPartsThatNeedThemGetReducedGrasps) {
   const Scene s = CollarOnPlate();
@@ -140,16 +140,16 @@ TEST(GraspTypes, OnlyPartsThatNeedThemGetReducedGrasps) {
   RunContext ctx(5);
   auto pre = Preprocess(s.project, s.check, Quick(), ctx);
   ASSERT_TRUE(pre) << pre.error().message;
-  EXPECT_GE(SetOf(*pre, "plate").assembly_candidates_by_type[0],
-            TwoFingerGraspOptions{}.reduced_below);
+  const int threshold = ReducedGraspThreshold(TwoFingerGraspOptions{}, pre->grasps_per_set);
+  EXPECT_GT(threshold, 0);
+  EXPECT_GE(SetOf(*pre, "plate").assembly_candidates_by_type[0], threshold);
   EXPECT_EQ(reduced_count(SetOf(*pre, "plate")), 0);
-  EXPECT_LT(SetOf(*pre, "collar").assembly_candidates_by_type[0],
-            TwoFingerGraspOptions{}.reduced_below);
+  EXPECT_LT(SetOf(*pre, "collar").assembly_candidates_by_type[0], threshold);
   EXPECT_GT(reduced_count(SetOf(*pre, "collar")), 0);
 
-  // reduced_below = 0: no part needs them.
+  // reduced_below_share = 0: no part needs them.
   PreprocessOptions never = Quick();
-  never.two_finger.reduced_below = 0;
+  never.two_finger.reduced_below_share = 0.0;
   RunContext ctx2(5);
   auto none = Preprocess(s.project, s.check, never, ctx2);
   ASSERT_TRUE(none) << none.error().message;
@@ -229,6 +229,19 @@ TEST(GraspTypes, TheLpDecidesWhetherAReducedGraspSuffices) {
       GraspTorqueScale({3e-5, 8e-3, 4e-3}, kFullArea, Vec3::UnitX(), Vec3::UnitZ());
   EXPECT_NEAR(fingertip.y(), 0.4, 1e-12);
   EXPECT_FALSE(check(fingertip)) << "fingertip at the same pose";
+}
+
+// The threshold is a share of the set, so a larger set asks for more full-pad assembly grasps
+// before it goes without reduced ones (the gamepad's slide has 4-10 of 256).
+TEST(GraspTypes, ReducedGraspThresholdIsAShareOfTheSet) {
+  TwoFingerGraspOptions options;
+  EXPECT_EQ(ReducedGraspThreshold(options, 64), 16);
+  EXPECT_EQ(ReducedGraspThreshold(options, 5), 2);
+  EXPECT_EQ(ReducedGraspThreshold(options, 256), 64);
+  options.reduced_below_share = 0.0;
+  EXPECT_EQ(ReducedGraspThreshold(options, 64), 0);
+  options.reduced_below_share = 1.0;
+  EXPECT_EQ(ReducedGraspThreshold(options, 64), 64);
 }
 
 }  // namespace

@@ -504,7 +504,8 @@ const std::vector<std::string> kExampleProjects = {
 #if WRAP_TEST_WITH_OCCT
     "stool_step",
 #endif
-    "fabrica_beam", "fabrica_plumbers_block", "fabrica_car"};
+    "fabrica_beam", "fabrica_plumbers_block", "fabrica_car", "fabrica_gamepad",
+    "fabrica_cooling_manifold"};
 // clang-format on
 
 INSTANTIATE_TEST_SUITE_P(Projects, ExampleProject, ::testing::ValuesIn(kExampleProjects));

@@ -89,7 +89,8 @@ TEST_P(ExampleReach, EveryPartCanBeGraspedFromAboveByTwoRobots) {
 INSTANTIATE_TEST_SUITE_P(Projects, ExampleReach,
                          ::testing::Values("stool", "chair", "cross", "cross_openarm", "cube",
                                            "cube_2x2x3", "half_stool", "fabrica_beam",
-                                           "fabrica_plumbers_block", "fabrica_car"));
+                                           "fabrica_plumbers_block", "fabrica_car", "fabrica_gamepad",
+                                           "fabrica_cooling_manifold"));
 
 }  // namespace
 }  // namespace wrap

@@ -173,7 +173,7 @@ const std::vector<std::string> kExamplePlans = {
     "stool_step",
 #endif
     "chair", "cross", "cross_openarm", "cube", "cube_2x2x3", "fabrica_plumbers_block",
-    "fabrica_beam", "fabrica_car"};
+    "fabrica_beam", "fabrica_car", "fabrica_gamepad", "fabrica_cooling_manifold"};
 // clang-format on
 
 INSTANTIATE_TEST_SUITE_P(Projects, ExamplePlan, ::testing::ValuesIn(kExamplePlans),
