@@ -11,8 +11,14 @@ namespace wrap::bench {
 
 namespace {
 
-const std::vector<std::string> kComparisonProjects = {
-    "cross", "stool", "chair", "fabrica_beam", "fabrica_plumbers_block", "fabrica_car"};
+const std::vector<std::string> kComparisonProjects = {"cross",
+                                                      "stool",
+                                                      "chair",
+                                                      "fabrica_beam",
+                                                      "fabrica_plumbers_block",
+                                                      "fabrica_car",
+                                                      "fabrica_gamepad",
+                                                      "fabrica_cooling_manifold"};
 
 // Markdown table cells cannot hold a bar or a line break.
 std::string MdCell(std::string s) {

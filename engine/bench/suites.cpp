@@ -74,8 +74,10 @@ void PaperSuite(std::vector<RunSpec>& out, int runs, double task_limit, double m
 }
 
 void FabricaSuite(std::vector<RunSpec>& out, int runs, double task_limit, double motion_limit) {
-  ComparisonAndBreakdown(out, {"fabrica_beam", "fabrica_plumbers_block", "fabrica_car"}, runs,
-                         task_limit, motion_limit);
+  ComparisonAndBreakdown(out,
+                         {"fabrica_beam", "fabrica_plumbers_block", "fabrica_car",
+                          "fabrica_gamepad", "fabrica_cooling_manifold"},
+                         runs, task_limit, motion_limit);
 }
 
 void ScalingSuite(std::vector<RunSpec>& out, int runs, double limit) {
