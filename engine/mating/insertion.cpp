@@ -82,6 +82,12 @@ PathHit Sweep(AssemblyGeometry& g, const InsertionPath& path, bool last, SweepSt
 
 }  // namespace
 
+double AllowedOverlap(double interference_travel_m, double interference_depth_m,
+                      double touch_depth_m, double s_m) {
+  return s_m <= interference_travel_m + 1e-9 ? std::max(interference_depth_m, touch_depth_m)
+                                             : touch_depth_m;
+}
+
 Iso3 PathPose(const AssemblyGeometry& g, const InsertionPath& path, int part, double s_m) {
   Iso3 X = path.X_BM * g.X_AP(part);
   X.translation() -= s_m * path.axis_A;

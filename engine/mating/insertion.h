@@ -42,6 +42,13 @@ struct SweepStats {
   long long triangle_tests = 0;  ///< Pairs of triangles whose travel interval was computed.
 };
 
+/// The overlap allowed between a moved input and its base `s_m` back from the mating pose: the
+/// interference band's (the larger of interference_depth_m and touch_depth_m) within the last
+/// interference_travel_m, touch_depth_m elsewhere. The one rule of the sweeps, the trajectory
+/// check and the insertion skill.
+double AllowedOverlap(double interference_travel_m, double interference_depth_m,
+                      double touch_depth_m, double s_m);
+
 /// The moved input's pose (frame A) `s_m` back along the path from its mating pose, for part p.
 Iso3 PathPose(const AssemblyGeometry& geometry, const InsertionPath& path, int part, double s_m);
 

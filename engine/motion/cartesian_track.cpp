@@ -78,18 +78,19 @@ std::vector<std::vector<JointVector>> SegmentBuilder::Track(
       out[k][i] = q;
     }
   }
-  return Simplify(robots, std::move(out));
+  return Simplify(robots, std::move(out), std::min(tolerance_m, kTrackTolerance));
 }
 
 std::vector<std::vector<JointVector>> SegmentBuilder::Simplify(
-    const std::vector<int>& robots, std::vector<std::vector<JointVector>> path) const {
+    const std::vector<int>& robots, std::vector<std::vector<JointVector>> path,
+    double tolerance_m) const {
   // Arms that hold one object together keep every sample: where two grippers leave their
   // lines differently they pull on the object against each other (MuJoCo saw 50 N inside a
   // cross's base carried with 0.2 mm of tolerance, more than stop and go costs).
   if (path.size() <= 2 || robots.size() > 1) return path;
-  // One arm may leave its Cartesian line by half a millimetre.
-  const double tol_m = 5e-4;
-  const double tol_rad = 5e-3;
+  // One arm may leave its Cartesian line by the tolerance (half a millimetre unless said).
+  const double tol_m = tolerance_m;
+  const double tol_rad = 10.0 * tolerance_m;
   std::vector<std::vector<Iso3>> X(path.size(), std::vector<Iso3>(robots.size()));
   for (size_t k = 0; k < path.size(); ++k) {
     for (size_t i = 0; i < robots.size(); ++i) X[k][i] = Tcp(robots[i], path[k][i]);

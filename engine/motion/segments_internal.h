@@ -35,6 +35,13 @@ constexpr double kTrackTolerance = 5e-4;
 // closed (BackOff) [m]: only its clearance matters there, which the tracked samples are checked
 // for. A 7-DoF arm at a joint limit tracks a line to about a millimetre, not half of one.
 constexpr double kLooseTrackTolerance = 3e-3;
+// An insertion's line is tracked and thinned to this fraction of the depth two touching parts
+// may overlap (Geometry::touch_depth_m, 0.2 mm): the moved part slides along a face of the base
+// with no clearance (the plumber's block: a block that left its line by 0.5 mm between two kept
+// samples cut 0.3 mm into the base, and the trajectory check refused the plan).
+constexpr double kInsertLineShare = 0.5;
+// ... but no tighter than this [m] (a project that allows no overlap at all).
+constexpr double kMinInsertLineTolerance = 5e-5;
 // A tracked straight move must end this close to its keyframe's joints [rad]; farther, it has
 // reached another IK solution of the same TCP pose, which replaces the keyframe's when valid.
 constexpr double kMaxSnap = 0.05;
@@ -201,11 +208,13 @@ class SegmentBuilder {
       const std::vector<std::function<Iso3(double)>>& targets, int steps,
       const std::vector<JointVector>* goals = nullptr, double tolerance_m = kTrackTolerance);
   // One arm's path: the fewest of its samples (the first and the last kept) between which straight
-  // joint motion stays within a fraction of a millimetre of every dropped sample's TCP pose: a
-  // skill is timed piece by piece, each piece from rest to rest, so a line tracked at millimetres
-  // would be driven in jerks (MuJoCo saw the load on a lifting gripper swing by +-30%).
+  // joint motion stays within `tolerance_m` (at most kTrackTolerance; a tenth of it in radians
+  // times 10) of every dropped sample's TCP pose: a skill is timed piece by piece, each piece
+  // from rest to rest, so a line tracked at millimetres would be driven in jerks (MuJoCo saw
+  // the load on a lifting gripper swing by +-30%).
   std::vector<std::vector<JointVector>> Simplify(const std::vector<int>& robots,
-                                                 std::vector<std::vector<JointVector>> path) const;
+                                                 std::vector<std::vector<JointVector>> path,
+                                                 double tolerance_m) const;
   // Collision-free straight joint motion between consecutive waypoints (scene already set).
   bool PathClear(const std::vector<int>& robots,
                  const std::vector<std::vector<JointVector>>& waypoints);
@@ -305,6 +314,8 @@ class SegmentBuilder {
   // The insertion of action i: the holders of its moved input slide it straight from where they
   // are to the keyframe (its joints may move to another IK solution of the same TCP pose).
   bool Insert(int i);
+  bool InsertionWithinOverlap(int i, const std::vector<int>& inserters,
+                              const std::vector<std::vector<JointVector>>& path);
 
   // --- Carries (carries.cpp).
   bool Carry(int action, int node, const std::vector<int>& holders, const Iso3& X_goal,

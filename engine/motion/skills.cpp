@@ -418,6 +418,50 @@ bool SegmentBuilder::HoverAbove(int action, Keyframe& goal, std::vector<int>& ho
                   " cannot lower it straight onto the table where its insertion starts: " + why);
 }
 
+// Whether the moved input of action i's insertion stays within the overlap the geometry allows
+// of its base along `path` (the first inserter's waypoints, straight joint motion between them:
+// as the trajectory check will see it), sampled every millimetre of the TCP's travel.
+bool SegmentBuilder::InsertionWithinOverlap(int i, const std::vector<int>& inserters,
+                                            const std::vector<std::vector<JointVector>>& path) {
+  const PlanAction& a = plan_.actions[i];
+  const Keyframe& K = a.keyframe;
+  const int m_node = a.objects[0], b_node = a.objects[1];
+  if (a.objects.size() < 3 || a.objects[2] < w_.num_parts || !w_.check) return true;
+  const PlanObject* m_obj = nullptr;
+  const PlanObject* b_obj = nullptr;
+  for (const PlanObject& o : K.objects) {
+    if (o.node == m_node) m_obj = &o;
+    if (o.node == b_node) b_obj = &o;
+  }
+  if (!m_obj || !b_obj) return true;
+  if (!geometry_) geometry_.emplace(AssemblyGeometry::FromProject(*w_.project, *w_.check));
+  const StepInterface& st = w_.interface(a.objects[2]);
+  const int r0 = inserters[0];
+  const Iso3 X_TM = Tcp(r0, K.q[r0]).inverse() * m_obj->X_WA;  // M in the TCP's frame
+  std::vector<Iso3> X(w_.num_parts, Iso3::Identity());
+  for (int p : w_.tree->nodes[b_node].parts) X[p] = b_obj->X_WA * w_.X_AP[p];
+  const double touch = w_.project->geometry.touch_depth_m;
+  for (size_t k = 1; k < path.size(); ++k) {
+    const JointVector& qa = path[k - 1][0];
+    const JointVector& qb = path[k][0];
+    const double travel =
+        (Tcp(r0, qb).translation() - Tcp(r0, qa).translation()).norm();
+    const int n = std::clamp(static_cast<int>(std::ceil(travel / 1e-3)), 1, 64);
+    for (int j = 1; j <= n; ++j) {
+      const Iso3 X_WM = Tcp(r0, qa + (static_cast<double>(j) / n) * (qb - qa)) * X_TM;
+      for (int p : w_.tree->nodes[m_node].parts) X[p] = X_WM * w_.X_AP[p];
+      const double back = -(b_obj->X_WA.inverse() * X_WM).translation().dot(st.axis_A);
+      const double allowed = AllowedOverlap(st.mating->interference_travel_m,
+                                            st.mating->interference_depth_m, touch, back);
+      if (OverlapBeyond(*geometry_, w_.tree->nodes[m_node].parts, w_.tree->nodes[b_node].parts,
+                        X, allowed)) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 bool SegmentBuilder::Insert(int i) {
   const PlanAction& a = plan_.actions[i];
   const Keyframe& K = a.keyframe;
@@ -441,16 +485,30 @@ bool SegmentBuilder::Insert(int i) {
   const int steps = std::max(2, static_cast<int>(std::ceil(len / opt_.cartesian_step_m)));
   std::vector<JointVector> goals;
   for (int r : inserters) goals.push_back(K.q[r]);
-  auto path = Track(inserters, q0, targets, steps, &goals);
-  bool ok = !path.empty();
-  for (size_t k = 0; ok && k < inserters.size(); ++k) {
-    const int r = inserters[k];
-    if ((path.back()[k] - K.q[r]).cwiseAbs().maxCoeff() > kMaxSnap) {
-      ok = KeyframeAccepts(r, path.back()[k], K, {{m_node, b_node}});
-      if (ok) Rebranch(r, i, false, K.q[r], path.back()[k]);
+  // The line tracked to the usual tolerance, ending at the keyframe's joints (or another IK
+  // solution of its pose that the keyframe accepts).
+  const auto track = [&](double tolerance_m) {
+    auto path = Track(inserters, q0, targets, steps, &goals, tolerance_m);
+    bool ok = !path.empty();
+    for (size_t k = 0; ok && k < inserters.size(); ++k) {
+      const int r = inserters[k];
+      if ((path.back()[k] - K.q[r]).cwiseAbs().maxCoeff() > kMaxSnap) {
+        ok = KeyframeAccepts(r, path.back()[k], K, {{m_node, b_node}});
+        if (ok) Rebranch(r, i, false, K.q[r], path.back()[k]);
+      }
+      if (ok) path.back()[k] = K.q[r];
     }
-    if (ok) path.back()[k] = K.q[r];
+    if (!ok) path.clear();
+    return path;
+  };
+  auto path = track(kTrackTolerance);
+  // A moved input that slides along its base with no clearance leaves no room for the line's
+  // usual tolerance: tracked and thinned again within a fraction of the touch depth.
+  if (!path.empty() && !InsertionWithinOverlap(i, inserters, path)) {
+    path = track(std::max(kInsertLineShare * w_.project->geometry.touch_depth_m,
+                          kMinInsertLineTolerance));
   }
+  bool ok = !path.empty();
   if (ok) {
     if (!SetScene(opening_, {{m_node, b_node}}, {m_node})) return false;
     ok = PathClear(inserters, path);

@@ -202,9 +202,8 @@ void Checker::CheckInsertionOverlap(double t, int step_node, int M, int B,
   // How far M is back along its path: X_WM = X_WB translated by -s along the axis.
   const double s = -(b->second.inverse() * m->second).translation().dot(st.axis_A);
   const double touch = w_.project->geometry.touch_depth_m;
-  const double allowed = s <= mating.interference_travel_m + 1e-9
-                             ? std::max(mating.interference_depth_m, touch)
-                             : touch;
+  const double allowed =
+      AllowedOverlap(mating.interference_travel_m, mating.interference_depth_m, touch, s);
   std::vector<Iso3> X(w_.num_parts, Iso3::Identity());
   for (int node : {M, B}) {
     for (int p : w_.tree->nodes[node].parts) X[p] = X_WA.at(node) * w_.X_AP[p];

@@ -88,6 +88,22 @@ TEST(PlanCli, PlansValidatesAndWritesThePlan) {
 
 // --log writes the topics' lines to stderr and changes nothing in the plan; an unknown topic is
 // a usage error listing the known ones.
+// The plumber's block's block slides into its base with no clearance: an insertion thinned to
+// the usual half millimetre cut 0.3 mm into the base, the trajectory check refused every task
+// plan, and seed 2 found no motion in 600 s. The insertion skill now keeps the moved input
+// within the touch depth (SegmentBuilder::InsertionWithinOverlap). No wall-clock bound: only
+// the work budgets end the run.
+TEST(PlanCli, AnInsertionWithNoClearanceKeepsToItsLine) {
+  if (!fs::exists(fs::path(WRAP_SHARED_DIR) / "fabrica")) {
+    GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
+  }
+  const CliRun r = Wrap({"plan", Project("fabrica_plumbers_block"), "--seed", "2", "--validate",
+                         "--time-limit", "3600", "-o", (TempDir("block") / "plan.json").string()});
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("Motion: makespan"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("events and grasps: no issue"), std::string::npos) << r.out;
+}
+
 TEST(PlanCli, LogTopicsGoToStderrAndLeaveThePlanAlone) {
   const fs::path dir = TempDir("log");
   const CliRun quiet = Wrap({"plan", Project("half_stool"), "-o", (dir / "quiet.json").string()});
