@@ -12,7 +12,7 @@ shift 2 || true
 projects=("$@")
 if [[ ${#projects[@]} -eq 0 ]]; then
   projects=(stool half_stool chair cross cross_openarm cube cube_2x2x3 fabrica_beam fabrica_car
-    fabrica_plumbers_block)
+    fabrica_plumbers_block fabrica_gamepad fabrica_cooling_manifold)
 fi
 wrap=${WRAP:-build/app/wrap}
 limit=${TIME_LIMIT:-60}

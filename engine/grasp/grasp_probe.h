@@ -46,6 +46,11 @@ class GraspProbe {
   /// `others` (all at their poses X_AP).
   int ClearOf(int part, int ee, std::span<const int> others);
 
+  /// The same for the reduced (partial-pad, fingertip) candidates of `part` for two-finger
+  /// `ee`, sampled on first use with a pool 16 times `candidates` (a wheel held by its tire's
+  /// edge, a pipe by its collar); 0 for other end effectors.
+  int ReducedClearOf(int part, int ee, std::span<const int> others);
+
  private:
   GraspProbe();
   struct Impl;

@@ -158,7 +158,8 @@ TEST(NewCli, AStepFileWithOnePartIsRefused) {
 
 INSTANTIATE_TEST_SUITE_P(Examples, NewFromMeshes,
                          ::testing::Values("stool", "cross", "fabrica_beam",
-                                           "fabrica_plumbers_block"),
+                                           "fabrica_plumbers_block", "fabrica_car",
+                                           "fabrica_gamepad", "fabrica_cooling_manifold"),
                          [](const auto& param_info) { return param_info.param; });
 
 TEST(SuggestCli, SidewaysLegGetsItsFreeAxisAndApplies) {

@@ -116,5 +116,24 @@ TEST(Sequence, PlateWithPegsIsTheBase) {
   EXPECT_GT(first.moved_grasps, 0) << first.why;
 }
 
+// A collar 6 mm tall on a plate: no full-pad grasp holds it (a pad needs 1 cm^2 of its 16 mm
+// wide faces), but fingertips on its upper edge clear the plate where mated. It stays the moved
+// input; before reduced grasps counted, the roles swapped to the plate lowered onto the collar
+// (the Fabrica car's body onto a wheel, which the planner could not support).
+TEST(Sequence, APartHeldOnlyByItsFingertipsKeepsTheMovedRole) {
+  Scene s;
+  s.Add("plate", BoxMesh(Mm(-30, -30, 0), Mm(30, 30, 4)));
+  s.Add("collar", BoxMesh(Mm(-8, -8, 4), Mm(8, 8, 10)));
+  const ProposedSequence seq = Sequence(s, true);
+  ASSERT_TRUE(seq.ok());
+  ASSERT_EQ(seq.steps.size(), 1u);
+  const ProposedStep& step = seq.steps[0];
+  EXPECT_EQ(step.moved, std::vector<int>{1}) << step.why;
+  EXPECT_EQ(step.base, std::vector<int>{0}) << step.why;
+  EXPECT_FALSE(step.swapped) << step.why;
+  EXPECT_GT(step.moved_grasps, 0) << step.why;
+  EXPECT_TRUE(IsAxis(step.axis_A, -Vec3::UnitZ())) << step.why;
+}
+
 }  // namespace
 }  // namespace wrap
