@@ -210,6 +210,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
     // BENCHMARKS.md) before the next level, which usually solves it at once.
     level_cap_ =
         level + 1 < levels ? expansions_ + kLevelExpansions : std::numeric_limits<long long>::max();
+    level_assembly_failures_ = 0;
     if (use_backward_) {
       const auto bwd_start = Clock::now();
       BuildBackward(m, res, s0);

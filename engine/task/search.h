@@ -347,6 +347,7 @@ class TaskSearch {
   /// Expansions after which a resolution level that is not the last counts as exhausted (the
   /// fill widens): no cap at the last level, which keeps the fill complete.
   long long level_cap_ = std::numeric_limits<long long>::max();
+  int level_assembly_failures_ = 0;  // failed assembly edges at this level (lazy_search.cpp)
   std::size_t rss0_ = 0;  ///< Resident memory when the search was made [bytes].
   /// Steps of the window assembled in `s` (they are assembled in order).
   int WindowDone(const SymState& s) const;
