@@ -500,8 +500,8 @@ TEST_P(ExampleProjects, PreprocessGivesPlacementsGraspsAndReachableSlots) {
 INSTANTIATE_TEST_SUITE_P(Projects, ExampleProjects,
                          ::testing::Values("stool", "chair", "cross", "cross_openarm", "cube",
                                            "cube_2x2x3", "half_stool", "fabrica_beam",
-                                           "fabrica_plumbers_block", "fabrica_car", "fabrica_gamepad",
-                                           "fabrica_cooling_manifold"));
+                                           "fabrica_plumbers_block", "fabrica_car",
+                                           "fabrica_gamepad", "fabrica_cooling_manifold"));
 
 // The cooling manifold's pipes are held only by fingertips on the collar from above, where the
 // elbow fits between the open fingers: 0 of ~1000 reduced candidates cleared the plate on seeds
