@@ -6,7 +6,8 @@
 // - cartesian_track.cpp: straight TCP moves tracked by IK, and their collision checks;
 // - free_paths.cpp: free paths (RRT-Connect queries in the composite space of the robots that
 //   move, through ompl_adapter.h), reused from the cache where the scene is the same;
-// - skills.cpp: approach, retreat, lift, descent and insertion;
+// - skills.cpp: approach, retreat, lift and descent;
+// - insertion_skill.cpp: the insertion, its slide start and hover, and its overlap check;
 // - carries.cpp: two-handed carries (straight variants, then a search over the object's poses).
 #pragma once
 
@@ -294,6 +295,8 @@ class SegmentBuilder {
                     std::vector<JointVector>& back, double& length);
   // A placement: the straight descent onto the table, top to bottom (w.descend).
   bool PlanPlaceDescent(int i, ActionWork& w);
+
+  // --- The insertion (insertion_skill.cpp).
   // The start of an insertion's slide. The task planner lets the moved input touch the base at
   // the approach keyframe (faces that slide along each other, as in a stack of cubes), but a
   // free path or a carry cannot end in that contact. When the moved input touches the base
@@ -314,6 +317,9 @@ class SegmentBuilder {
   // The insertion of action i: the holders of its moved input slide it straight from where they
   // are to the keyframe (its joints may move to another IK solution of the same TCP pose).
   bool Insert(int i);
+  // Whether the moved input of action i's insertion stays within the overlap the geometry allows
+  // of its base along `path` (the first inserter's waypoints, straight joint motion between
+  // them), sampled every millimetre of the TCP's travel.
   bool InsertionWithinOverlap(int i, const std::vector<int>& inserters,
                               const std::vector<std::vector<JointVector>>& path);
 
