@@ -62,27 +62,6 @@ double ClearLength(AssemblyGeometry& g, const std::vector<int>& unit,
   return (hi - lo).norm() + 0.01;
 }
 
-// Grasps of `unit` that leave the gripper clear of `rest` where mated: full-pad ones, else
-// (none) reduced ones, which the planner's grasp sets hold too (a wheel by its tire's edge, a
-// pipe by its collar: without them the roles swapped to a base that cannot take the insertion).
-int ClearGrasps(GraspProbe* probe, int ee, const std::vector<int>& unit,
-                const std::vector<int>& rest) {
-  if (probe == nullptr) return 0;
-  const auto count = [&](bool reduced) {
-    int n = 0;
-    for (int p : unit) {
-      std::vector<int> others = rest;
-      for (int q : unit) {
-        if (q != p) others.push_back(q);
-      }
-      n += reduced ? probe->ReducedClearOf(p, ee, others) : probe->ClearOf(p, ee, others);
-    }
-    return n;
-  };
-  const int full = count(false);
-  return full > 0 ? full : count(true);
-}
-
 // The best free axis of `unit` leaving `rest`, if any.
 std::optional<Vec3> BestFreeAxis(AssemblyGeometry& g, const ContactGraph& graph,
                                  const std::vector<int>& unit, const std::vector<int>& rest,
@@ -210,6 +189,24 @@ void AssignRoles(AssemblyGeometry& g, GraspProbe* probe, const SequenceOptions& 
 }
 
 }  // namespace
+
+int ClearGrasps(GraspProbe* probe, int ee, const std::vector<int>& unit,
+                const std::vector<int>& rest) {
+  if (probe == nullptr) return 0;
+  const auto count = [&](bool reduced) {
+    int n = 0;
+    for (int p : unit) {
+      std::vector<int> others = rest;
+      for (int q : unit) {
+        if (q != p) others.push_back(q);
+      }
+      n += reduced ? probe->ReducedClearOf(p, ee, others) : probe->ClearOf(p, ee, others);
+    }
+    return n;
+  };
+  const int full = count(false);
+  return full > 0 ? full : count(true);
+}
 
 ProposedSequence ProposeSequence(AssemblyGeometry& g, const ContactGraph& graph, GraspProbe* probe,
                                  const SequenceOptions& options) {

@@ -39,6 +39,13 @@ struct SequenceOptions {
   int end_effector = 0;         ///< End effector of the probe the grasp counts use.
 };
 
+/// Grasps of `unit` (parts) for end effector `ee` of `probe` that leave the gripper clear of
+/// `rest` (and of the unit's other parts) where mated: full-pad ones, else (none) reduced ones,
+/// which the planner's grasp sets hold too (a wheel by its tire's edge, a pipe by its collar).
+/// The one count behind the roles of `wrap new` and `wrap suggest`; 0 without a probe.
+int ClearGrasps(GraspProbe* probe, int ee, const std::vector<int>& unit,
+                const std::vector<int>& rest);
+
 /// Assembly by disassembly. Each round tries every remaining part that touches the rest and
 /// leaves the rest connected, along the frame's axes and the contact normals (then the sphere),
 /// swept until it clears the rest; it takes off the best by, in order: not the largest part (by

@@ -147,9 +147,8 @@ Result<SuggestResult> SuggestFixes(const Project& project, const ProjectCheck& c
       }
       const auto& moved = check.tree->nodes[sg.moved].parts;
       const auto& base = check.tree->nodes[sg.base].parts;
-      int mg = 0, bg = 0;
-      for (int p : moved) mg += probe->ClearOf(p, 0, base);
-      for (int p : base) bg += probe->ClearOf(p, 0, moved);
+      const int mg = ClearGrasps(&*probe, 0, moved, base);
+      const int bg = ClearGrasps(&*probe, 0, base, moved);
       if (mg == 0 && bg > 0) {
         out.suggestions.push_back(
             {StepPath(sg.step) + ".mating",
