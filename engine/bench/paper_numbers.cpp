@@ -10,7 +10,12 @@ namespace wrap::bench {
 
 namespace {
 
-const std::vector<std::string>& Columns() {
+PaperComparison N(double t, double c) { return {t, c, ""}; }
+PaperComparison W(const char* word) { return {0.0, 0.0, word}; }
+
+}  // namespace
+
+const std::vector<std::string>& PaperComparisonProjects() {
   static const std::vector<std::string> c = {"cross",
                                              "stool",
                                              "chair",
@@ -21,11 +26,6 @@ const std::vector<std::string>& Columns() {
                                              "fabrica_cooling_manifold"};
   return c;
 }
-
-PaperComparison N(double t, double c) { return {t, c, ""}; }
-PaperComparison W(const char* word) { return {0.0, 0.0, word}; }
-
-}  // namespace
 
 std::optional<PaperComparison> PaperComparisonCell(const std::string& project,
                                                    const std::string& planner) {
@@ -51,8 +51,8 @@ std::optional<PaperComparison> PaperComparisonCell(const std::string& project,
   };
   const auto row = table.find(planner);
   if (row == table.end()) return std::nullopt;
-  for (size_t i = 0; i < Columns().size(); ++i) {
-    if (Columns()[i] == project) return row->second[i];
+  for (size_t i = 0; i < PaperComparisonProjects().size(); ++i) {
+    if (PaperComparisonProjects()[i] == project) return row->second[i];
   }
   return std::nullopt;
 }

@@ -4,8 +4,12 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace wrap::bench {
+
+/// The example projects that have a column of Table "comparison", in the paper's order.
+const std::vector<std::string>& PaperComparisonProjects();
 
 /// A cell of Table "comparison": mean time to first plan [s] and cost, or a word.
 struct PaperComparison {

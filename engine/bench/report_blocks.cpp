@@ -7,18 +7,11 @@
 #include <map>
 #include <sstream>
 
+#include "bench/paper_numbers.h"
+
 namespace wrap::bench {
 
 namespace {
-
-const std::vector<std::string> kComparisonProjects = {"cross",
-                                                      "stool",
-                                                      "chair",
-                                                      "fabrica_beam",
-                                                      "fabrica_plumbers_block",
-                                                      "fabrica_car",
-                                                      "fabrica_gamepad",
-                                                      "fabrica_cooling_manifold"};
 
 // Markdown table cells cannot hold a bar or a line break.
 std::string MdCell(std::string s) {
@@ -159,7 +152,7 @@ void ReportBlocks::Figure(const std::string& file, const std::string& caption,
 }
 
 std::vector<std::string> ProjectOrder(const std::set<std::string>& projects) {
-  std::vector<std::string> order = kComparisonProjects;
+  std::vector<std::string> order = PaperComparisonProjects();
   for (const std::string& p : projects) {
     if (std::find(order.begin(), order.end(), p) == order.end()) order.push_back(p);
   }

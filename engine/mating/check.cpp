@@ -71,7 +71,8 @@ void ReportPaths(const Project& project, const AssemblyTree& tree, const Assembl
     if (!m.final_poses.empty()) msg += " into final pose " + std::to_string(k);
     if (hit.at_m <= m.interference_travel_m + 1e-9) {
       msg += " overlaps " + InputPart(g, base, hit.base_part) + " by more than the " +
-             FormatMm(std::max(m.interference_depth_m, project.geometry.touch_depth_m)) +
+             FormatMm(AllowedOverlap(m.interference_travel_m, m.interference_depth_m,
+                                     project.geometry.touch_depth_m, hit.at_m)) +
              " allowed in its last " + FormatMm(m.interference_travel_m) +
              " (interference_depth_m, interference_travel_m)";
     } else {

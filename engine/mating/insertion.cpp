@@ -68,7 +68,8 @@ PathHit SweepRange(AssemblyGeometry& g, const InsertionPath& path, double allowe
 PathHit Sweep(AssemblyGeometry& g, const InsertionPath& path, bool last, SweepStats* stats) {
   const double length = std::max(0.0, path.length_m);
   const double band = std::clamp(path.interference_travel_m, 0.0, length);
-  const double band_allowed = std::max(path.interference_depth_m, path.touch_depth_m);
+  const double band_allowed = AllowedOverlap(path.interference_travel_m, path.interference_depth_m,
+                                             path.touch_depth_m, 0.0);
   if (band_allowed == path.touch_depth_m) {
     return SweepRange(g, path, band_allowed, 0.0, length, last, stats);
   }

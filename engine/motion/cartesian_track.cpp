@@ -81,6 +81,19 @@ std::vector<std::vector<JointVector>> SegmentBuilder::Track(
   return Simplify(robots, std::move(out), std::min(tolerance_m, kTrackTolerance));
 }
 
+std::vector<std::function<Iso3(double)>> SegmentBuilder::ShiftedTcps(
+    const std::vector<int>& robots, const std::vector<JointVector>& q, const Vec3& offset) const {
+  std::vector<std::function<Iso3(double)>> targets;
+  for (size_t i = 0; i < robots.size(); ++i) {
+    targets.push_back([X0 = Tcp(robots[i], q[i]), offset](double s) {
+      Iso3 X = X0;
+      X.translation() += s * offset;
+      return X;
+    });
+  }
+  return targets;
+}
+
 std::vector<std::vector<JointVector>> SegmentBuilder::Simplify(
     const std::vector<int>& robots, std::vector<std::vector<JointVector>> path,
     double tolerance_m) const {

@@ -46,17 +46,8 @@ void SegmentBuilder::SlideStart(int action, Keyframe& goal) {
   double first_extra = 0.0;
   for (double extra : {0.01, 0.02, 0.04, 0.06, 0.09, 0.12}) {
     if (a.objects.size() >= 3 && !LongerSlideFree(a.objects[2], extra)) break;
-    std::vector<std::function<Iso3(double)>> targets;
-    for (int r : holders) {
-      const Iso3 Xa = Tcp(r, goal.q[r]);
-      targets.push_back([Xa, u, extra](double s) {
-        Iso3 X = Xa;
-        X.translation() += s * extra * u;
-        return X;
-      });
-    }
     const int steps = std::max(2, static_cast<int>(std::ceil(extra / opt_.cartesian_step_m)));
-    const auto path = Track(holders, q0, targets, steps);
+    const auto path = Track(holders, q0, ShiftedTcps(holders, q0, extra * u), steps);
     if (path.empty()) continue;
     Keyframe pre = goal;
     for (size_t k = 0; k < holders.size(); ++k) pre.q[holders[k]] = path.back()[k];
@@ -121,16 +112,7 @@ bool SegmentBuilder::HoverAbove(int action, Keyframe& goal, std::vector<int>& ho
   for (const Vec3& dir : dirs) {
     for (double d : {opt_.skills.lift_m, 2 * opt_.skills.lift_m, opt_.skills.lift_m / 2}) {
       const double len = d / dir.z();
-      std::vector<std::function<Iso3(double)>> targets;
-      for (int r : holders) {
-        const Iso3 X0 = Tcp(r, goal.q[r]);
-        targets.push_back([X0, dir, len](double s) {
-          Iso3 X = X0;
-          X.translation() += s * len * dir;
-          return X;
-        });
-      }
-      auto path = Track(holders, q0, targets,
+      auto path = Track(holders, q0, ShiftedTcps(holders, q0, len * dir),
                         std::max(2, static_cast<int>(std::ceil(len / opt_.cartesian_step_m))));
       if (path.empty()) continue;
       Keyframe top = goal;

@@ -208,6 +208,10 @@ class SegmentBuilder {
       const std::vector<int>& robots, const std::vector<JointVector>& q0,
       const std::vector<std::function<Iso3(double)>>& targets, int steps,
       const std::vector<JointVector>* goals = nullptr, double tolerance_m = kTrackTolerance);
+  // Targets for Track: robot robots[i]'s TCP at joints q[i], translated by s * offset.
+  std::vector<std::function<Iso3(double)>> ShiftedTcps(const std::vector<int>& robots,
+                                                       const std::vector<JointVector>& q,
+                                                       const Vec3& offset) const;
   // One arm's path: the fewest of its samples (the first and the last kept) between which straight
   // joint motion stays within `tolerance_m` (at most kTrackTolerance; a tenth of it in radians
   // times 10) of every dropped sample's TCP pose: a skill is timed piece by piece, each piece

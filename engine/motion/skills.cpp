@@ -122,16 +122,8 @@ bool SegmentBuilder::Lift(int action, int node, const std::vector<int>& holders)
   std::string why;
   for (const auto& [dir, d] : moves) {
     std::vector<JointVector> q0;
-    std::vector<std::function<Iso3(double)>> targets;
-    for (int r : holders) {
-      q0.push_back(cur_[r]);
-      const Iso3 X0 = Tcp(r, cur_[r]);
-      targets.push_back([X0, d = d, dir = dir](double s) {
-        Iso3 X = X0;
-        X.translation() += s * d * dir;
-        return X;
-      });
-    }
+    for (int r : holders) q0.push_back(cur_[r]);
+    const auto targets = ShiftedTcps(holders, q0, d * dir);
     const int steps = std::max(2, static_cast<int>(std::ceil(d / opt_.cartesian_step_m)));
     auto path = Track(holders, q0, targets, steps);
     if (path.empty()) {
