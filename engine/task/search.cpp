@@ -229,13 +229,23 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
     }
     std::vector<AssemblyTarget> targets{AssemblyTarget{}};
     if (optimistic_) targets = OptimisticTargets(m, res, s0);
+    const long long level_start = expansions_;
     for (const AssemblyTarget& target : targets) {
       target_ = target;
       const SearchStatus status = Rounds(index, m, res, s0, c0, t0, excluded, limits, result);
       if (status != SearchStatus::kExhausted) {
+        if (ctx_.Logs("task") && result.ok) {
+          ctx_.Log("task", StrFormat("milestone %d level %d: found after %lld expansions", index,
+                                     level, expansions_ - level_start));
+        }
         finish();
         return result;
       }
+    }
+    if (ctx_.Logs("task")) {
+      ctx_.Log("task", StrFormat("milestone %d level %d: nothing after %lld expansions%s", index,
+                                 level, expansions_ - level_start,
+                                 expansions_ > level_cap_ ? " (level budget spent)" : ""));
     }
     if (optimistic_ && targets.empty()) {
       abstract_failure = "no assembly grasp of '" + world_.tree->nodes[m.moved].name +
