@@ -191,6 +191,7 @@ TaskSearch::SearchStatus TaskSearch::Rounds(int index, const Milestone& m, const
       if (status == SearchStatus::kStopped || status == SearchStatus::kOutOfMemory) {
         return stop(status);
       }
+      if (status == SearchStatus::kFound) level_cap_ = std::max(level_cap_, level_full_cap_);
       if (status == SearchStatus::kFound && g0 + static_cast<int>(path.size()) > max_actions) {
         status = SearchStatus::kExhausted;  // too long: treat as a dead end
       }

@@ -306,6 +306,42 @@ struct MilestoneRun {
   bool out_of_memory = false;  ///< Stopped by the memory limit.
 };
 
+// Fewest expansions a backtracking probe may take at each of its two milestones.
+constexpr long long kProbeMinExpansions = 2000;
+
+// Milestone k's first resolution level found nothing from the end of milestone k - 1 though it
+// searched its whole graph: that end may be a dead end that only the wider levels' exhaustive
+// search would prove (the stool's seed 1: a robot that cannot back away from the seat it holds,
+// 183k expansions). Before widening, probe once: another end of milestone k - 1 and milestone k
+// from it, each at the first level only. Keeps both and returns true when both are found;
+// otherwise leaves `results` and `excluded_before` as they were (the caller widens from the old
+// end). A probe stopped by cancellation or memory returns false; the widening then stops too.
+template <typename FillFn>
+bool ProbeAnotherEnd(FillFn& fill, int k, long long budget,
+                     std::set<std::uint64_t>& excluded_before,
+                     std::vector<MilestoneResult>& results, RunContext& ctx) {
+  const std::uint64_t old_end = results[k - 1].end.Hash();
+  const bool added = excluded_before.insert(old_end).second;
+  FillLimits probe;
+  probe.first_level_only = true;
+  probe.level_expansions = budget;
+  MilestoneResult before = fill(k - 1, probe);
+  if (before.ok) {
+    MilestoneResult old = std::move(results[k - 1]);
+    results[k - 1] = std::move(before);
+    MilestoneResult after = fill(k, probe);
+    if (after.ok) {
+      ctx.Log("task", "milestone " + std::to_string(k) +
+                          ": the probe of another end of the milestone before it found a plan");
+      results[k] = std::move(after);
+      return true;
+    }
+    results[k - 1] = std::move(old);
+  }
+  if (added) excluded_before.erase(old_end);
+  return false;
+}
+
 // The milestones in the DAG's topological order `order` from (s0, c0), with backtracking; Flat
 // lazy: one search.
 MilestoneRun FillMilestones(TaskSearch& search, const TaskWorld& world,
@@ -316,6 +352,14 @@ MilestoneRun FillMilestones(TaskSearch& search, const TaskWorld& world,
   run.results.resize(flat ? 1 : K);
   std::vector<MilestoneResult>& results = run.results;
   std::vector<std::set<std::uint64_t>> excluded(K);
+  // Fills milestone i from the end of milestone i - 1 as `results` has it.
+  auto fill = [&](int i, const FillLimits& limits) {
+    const SymState& s = i == 0 ? s0 : results[i - 1].end;
+    const ContState& c = i == 0 ? c0 : results[i - 1].end_c;
+    const TaskClock t = i == 0 ? TaskClock(static_cast<int>(world.robots.size()), world.num_nodes)
+                               : results[i - 1].end_clock;
+    return search.Fill(i, order[i], i + 1 < K ? order[i + 1] : -1, s, c, t, excluded[i], limits);
+  };
   int& k = run.reached;
   while (k < K) {
     const std::string words = flat
@@ -323,13 +367,28 @@ MilestoneRun FillMilestones(TaskSearch& search, const TaskWorld& world,
                                   : "milestone " + std::to_string(k + 1) + "/" + std::to_string(K) +
                                         " '" + world.tree->nodes[order[k]].name + "'";
     ctx.Progress("task", static_cast<double>(k) / std::max(1, K), words);
-    const SymState& s = k == 0 ? s0 : results[k - 1].end;
-    const ContState& c = k == 0 ? c0 : results[k - 1].end_c;
-    const TaskClock t = k == 0 ? TaskClock(static_cast<int>(world.robots.size()), world.num_nodes)
-                               : results[k - 1].end_clock;
-    MilestoneResult r =
-        flat ? search.FillFlat(s0, c0)
-             : search.Fill(k, order[k], k + 1 < K ? order[k + 1] : -1, s, c, t, excluded[k]);
+    MilestoneResult r;
+    if (flat) {
+      r = search.FillFlat(s0, c0);
+    } else {
+      const bool can_backtrack = k > 0 && run.backtracks < options.max_backtracks;
+      FillLimits limits;
+      limits.stop_when_first_exhausted = can_backtrack;
+      const long long expansions0 = search.expansions();
+      r = fill(k, limits);
+      if (r.first_level_exhausted) {
+        // The probe may take as much as the exhausted level took (at least a small floor).
+        const long long budget = std::max(kProbeMinExpansions, search.expansions() - expansions0);
+        if (ProbeAnotherEnd(fill, k, budget, excluded[k - 1], results, ctx)) {
+          ++run.backtracks;
+          ++k;
+          continue;
+        }
+        limits = FillLimits{};
+        limits.first_level = 1;
+        r = fill(k, limits);
+      }
+    }
     if (r.ok) {
       if (flat) {
         results[0] = std::move(r);

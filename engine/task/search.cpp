@@ -18,6 +18,11 @@ using Clock = std::chrono::steady_clock;
 // above what a solvable level takes (the median seed of every example needs under 20k for the
 // whole task), far below what an unsolvable one can take.
 constexpr long long kLevelExpansions = 50000;
+// Work budget of such a level until its search has found a first candidate plan: the car's seeds
+// 0, 2 and 5 searched 50k expansions at the second level without one (the abstraction said 3
+// actions; the grippers of every grasp of the subset hit the base when mated), and the next
+// level found a plan in 35.
+constexpr long long kBlindExpansions = 10000;
 
 }  // namespace
 
@@ -200,16 +205,22 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
   auto finish = [&]() {
     target_ = AssemblyTarget{};
     level_cap_ = std::numeric_limits<long long>::max();
+    level_full_cap_ = level_cap_;
     search_s_ += std::chrono::duration<double>(Clock::now() - start).count();
   };
-  for (int level = 0; level < levels; ++level) {
+  for (int level = limits.first_level; level < levels; ++level) {
     if (level + 1 == levels) reduced_grasps_ = true;
     const Resolution res = ResolutionAt(level);
     // A level that is not the last gets a work budget: a seed whose grasps at this resolution
     // admit no plan would otherwise exhaust a large graph (100k-600k expansions: the tails of
     // BENCHMARKS.md) before the next level, which usually solves it at once.
-    level_cap_ =
-        level + 1 < levels ? expansions_ + kLevelExpansions : std::numeric_limits<long long>::max();
+    // Until its search finds a first candidate plan, such a level gets kBlindExpansions: the
+    // abstraction promised a short way the forward graph does not have.
+    const long long budget = limits.level_expansions > 0 ? limits.level_expansions : kLevelExpansions;
+    level_full_cap_ =
+        level + 1 < levels ? expansions_ + budget : std::numeric_limits<long long>::max();
+    level_cap_ = level + 1 < levels ? expansions_ + std::min(budget, kBlindExpansions)
+                                    : std::numeric_limits<long long>::max();
     level_assembly_failures_ = 0;
     if (use_backward_) {
       const auto bwd_start = Clock::now();
@@ -222,6 +233,7 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
       if (!backward_.why.empty()) {
         // The relaxation cannot reach the assembly: neither can the search at this resolution.
         abstract_failure = backward_.why;
+        if (limits.first_level_only) break;
         if (level + 1 < levels) ++widenings_;
         continue;
       }
@@ -243,9 +255,19 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
       }
     }
     if (ctx_.Logs("task")) {
-      ctx_.Log("task", StrFormat("milestone %d level %d: nothing after %lld expansions%s", index,
-                                 level, expansions_ - level_start,
-                                 expansions_ > level_cap_ ? " (level budget spent)" : ""));
+      ctx_.Log("task", StrFormat("milestone %d level %d: nothing after %lld expansions%s; %s",
+                                 index, level, expansions_ - level_start,
+                                 expansions_ > level_cap_ ? " (level budget spent)" : "",
+                                 tally_.Summary().c_str()));
+    }
+    if (level == limits.first_level &&
+        (limits.first_level_only ||
+         (limits.stop_when_first_exhausted && expansions_ <= level_cap_ && !optimistic_))) {
+      finish();
+      result.first_level_exhausted = expansions_ <= level_cap_;
+      result.failure = words + ": nothing at resolution level " + std::to_string(level) + "; " +
+                       tally_.Summary();
+      return result;
     }
     if (optimistic_ && targets.empty()) {
       abstract_failure = "no assembly grasp of '" + world_.tree->nodes[m.moved].name +

@@ -75,6 +75,9 @@ struct MilestoneResult {
   std::vector<FailureCase> cases;  ///< The same as data, blocker first (FailureCase::scene: the
                                    ///< tried object moved, robots as at the milestone's start).
   FailureScene start;              ///< The cell at the milestone's start (failure record).
+  /// The first level searched its whole graph within its budget and found nothing, and the fill
+  /// stopped there (FillLimits::stop_when_first_exhausted).
+  bool first_level_exhausted = false;
 };
 
 /// Limits of one fill beyond the variant's own, for plan improvement.
@@ -83,6 +86,15 @@ struct FillLimits {
   int max_cost = 1 << 30;      ///< Most actions in the milestone (A* prunes g + h above it).
   int max_failures = 1 << 30;  ///< Edge validation failures before the fill gives up.
   long long max_nodes = 0;     ///< Nodes per search; 0: TaskPlannerOptions::max_nodes.
+  int first_level = 0;  ///< Resolution level to start at (a probe's caller skips a level done).
+  /// Expansions a level that is not the last may take; 0: the search's own budget.
+  long long level_expansions = 0;
+  /// Stop after the first level searched (whether or not it found a plan): a backtracking probe.
+  bool first_level_only = false;
+  /// Stop when the first level searched its whole graph within its budget and found nothing
+  /// (MilestoneResult::first_level_exhausted): the caller may probe another end of the milestone
+  /// before, rather than after, the wider levels.
+  bool stop_when_first_exhausted = false;
 };
 
 /// The lazy search of the task planner.
@@ -347,6 +359,9 @@ class TaskSearch {
   /// Expansions after which a resolution level that is not the last counts as exhausted (the
   /// fill widens): no cap at the last level, which keeps the fill complete.
   long long level_cap_ = std::numeric_limits<long long>::max();
+  /// The level's budget once its search has found a candidate plan (level_cap_ is lower until
+  /// then: kBlindExpansions).
+  long long level_full_cap_ = std::numeric_limits<long long>::max();
   int level_assembly_failures_ = 0;  // failed assembly edges at this level (lazy_search.cpp)
   std::size_t rss0_ = 0;  ///< Resident memory when the search was made [bytes].
   /// Steps of the window assembled in `s` (they are assembled in order).

@@ -196,6 +196,41 @@ TEST(WrapPlanTails, ALevelWhoseAssembliesKeepFailingWidensEarly) {
   EXPECT_LT(run.plan->stats.expansions, 5000);
 }
 
+// A milestone whose first level searches its whole graph in vain from the end of the milestone
+// before probes another end of that milestone before widening: the stool's seed 1 ended its
+// third milestone with 'ur5e_c' holding the seat where it cannot back its gripper away, and
+// proving at the wider levels that no plan leaves from there took 183k expansions (1.9 s against
+// the other seeds' 0.07 s). Counts, not times.
+TEST(WrapPlanTails, ADeadEndMilestoneStartIsLeftBeforeWidening) {
+  const fs::path file = ProjectFile("stool");
+  const LoadedProject lp = LoadProject(file);
+  ASSERT_TRUE(lp.ok());
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 1, kNoTimeLimit);
+  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
+  ASSERT_TRUE(run.plan->stats.solved) << run.plan->stats.failure;
+  ASSERT_TRUE(run.validation.has_value());
+  EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
+  EXPECT_GE(run.plan->stats.backtracks, 1);
+  EXPECT_LT(run.plan->stats.expansions, 30000);
+}
+
+// A level that is not the last and whose search finds no candidate plan at all within
+// kBlindExpansions widens: the car's seed 0 searched 50,001 expansions at its second level with
+// the abstraction promising 3 actions (every grasp of the subset puts a gripper into the wheel
+// when mated), and the widest level then found a plan in 35.
+TEST(WrapPlanTails, ALevelWithoutACandidateWidensAfterItsBlindBudget) {
+  const fs::path file = ProjectFile("fabrica_car");
+  const LoadedProject lp = LoadProject(file);
+  if (!lp.ok()) GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, kNoTimeLimit);
+  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
+  ASSERT_TRUE(run.plan->stats.solved) << run.plan->stats.failure;
+  ASSERT_TRUE(run.validation.has_value());
+  EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
+  EXPECT_GE(run.plan->stats.widenings, 2);
+  EXPECT_LT(run.plan->stats.expansions, 20000);
+}
+
 // When the backward abstraction cannot reach a step's assembly, WRAP says why at once instead of
 // searching: here wheel0 has lost every grasp (and the wrench model is off, so that the wrench
 // pre-check of the step does not answer first).
