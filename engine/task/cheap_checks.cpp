@@ -86,6 +86,33 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
   return ok;
 }
 
+bool TaskSearch::ApproachClear(const SymState& s, int robot, int node, int loc, int grasp) {
+  std::uint64_t key = HashMix(HashMix(HashMix(HashMix(105, robot), node), loc), grasp);
+  std::vector<std::pair<int, Iso3>>& others = approach_others_;
+  others.clear();
+  for (int n = 0; n < world_.num_nodes; ++n) {
+    if (n == node || s.loc[n] < 0) continue;
+    key = HashMix(HashMix(key, n), static_cast<std::uint64_t>(s.loc[n]));
+    others.push_back({n, tables_.location(s.loc[n]).X_WA});
+  }
+  if (others.empty()) return true;
+  if (int* index = cheap_.find(key)) return Recall(cheap_answers_[*index]);
+  int hit = -1;
+  const bool ok = solver_.ApproachClear(robot, grasp, tables_.location(loc).X_WA, others, &hit);
+  if (!ok) {
+    CheckSubject about{.object = node, .robot = robot, .grasp = grasp, .loc = loc};
+    about.hit_node = hit;
+    tally_.Add(Gate::kSkill,
+               "'" + world_.robots[robot].name + "' cannot approach grasp " +
+                   std::to_string(tables_.grasp(grasp).index) + " of '" +
+                   world_.tree->nodes[node].name + "' straight: its gripper hits '" +
+                   world_.tree->nodes[hit].name + "' resting beside it",
+               about);
+  }
+  Remember(key, ok);
+  return ok;
+}
+
 bool TaskSearch::CanBePicked(int node, int loc, int max_grasps) {
   for (int r = 0; r < n_robots_; ++r) {
     const std::vector<int>& ids = GraspIds(node, r);

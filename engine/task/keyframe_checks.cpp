@@ -25,6 +25,43 @@ constexpr int kStraightSamples = 4;
 
 }  // namespace
 
+bool KeyframeSolver::ApproachClear(int robot, int grasp, const Iso3& X_WA,
+                                   std::span<const std::pair<int, Iso3>> others, int* hit_node) {
+  // The end effector alone along the line StraightClear follows with the whole arm: a hit here
+  // is a hit there, whatever the arm's IK.
+  ++counters_.collision_checks;
+  const TaskRobot& r = world_.robots[robot];
+  const Iso3 X_WT = GraspTarget(X_WA, grasp);
+  const Vec3 back = -X_WT.linear().col(2);
+  CollisionWorld& w = cell_.world();
+  const BodyId ee = cell_.end_effector_body(robot);
+  if (fingers_[robot]) opening_[robot] = GraspOpening(grasp);
+  for (const auto& [node, X] : others) {
+    for (int p : world_.tree->nodes[node].parts) cell_.SetObjectPose(p, X * world_.X_AP[p]);
+  }
+  for (int k = 0; k <= kStraightSamples; ++k) {
+    Iso3 X_T = X_WT;
+    X_T.translation() += (options_.skills.min_straight_m * k / kStraightSamples) * back;
+    const Iso3 X_WF = X_T * r.end_effector.X_FT.inverse();
+    w.SetPose(ee, X_WF);
+    if (fingers_[robot]) PlaceFingers(robot, X_WF);
+    for (const auto& [node, X] : others) {
+      for (int p : world_.tree->nodes[node].parts) {
+        const BodyId part = cell_.object_body(p);
+        bool hit = w.Collide(ee, part);
+        for (int f = 0; f < 2 && !hit && fingers_[robot]; ++f) {
+          hit = w.Collide(fingers_[robot]->body[f], part);
+        }
+        if (hit) {
+          if (hit_node) *hit_node = node;
+          return false;  // every validation sets the robots and the scene again
+        }
+      }
+    }
+  }
+  return true;
+}
+
 bool KeyframeSolver::StraightClear(int robot, const JointVector& q, const Vec3& dir_W,
                                    double length_m, std::string* why) {
   const TaskRobot& r = world_.robots[robot];

@@ -9,6 +9,7 @@
 #include <functional>
 #include <optional>
 #include <random>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -103,6 +104,11 @@ class KeyframeSolver {
   /// Cheap and context-free: the gripper of `robot` at `grasp` on an object at X_WA (fingers
   /// closed to the grasp) does not touch the parts of `other_node` at X_other.
   bool GripperClear(int robot, int grasp, const Iso3& X_WA, int other_node, const Iso3& X_other);
+  /// Cheap: the end effector of `robot` at `grasp` on an object at X_WA (fingers at the grasp's
+  /// opening), and backed off along its axis by the grasp approach's least length, does not
+  /// touch the parts of the nodes of `others` at their poses. On a hit, `hit_node` is the node.
+  bool ApproachClear(int robot, int grasp, const Iso3& X_WA,
+                     std::span<const std::pair<int, Iso3>> others, int* hit_node);
   /// Robot-free and context-free: the end effectors of `robot_a` at grasp `grasp_a` and of
   /// `robot_b` at grasp `grasp_b` of one object keep the robots' minimum clearance (the two
   /// hands of a handover or of a two-handed hold).

@@ -300,6 +300,11 @@ class TaskSearch {
   /// The cheap checks of `robot` picking `node` resting at location `loc` at grasp `grasp`:
   /// reach, the gripper clear of the table, IK, carrying it right after the lift (cached).
   bool CheapPick(int robot, int node, int loc, int grasp);
+  /// The gripper of `robot` approaching grasp `grasp` of `node` resting at `loc` straight along
+  /// its axis (the approach the keyframe check asks for) clear of the other objects resting in
+  /// `s`: a necessary condition of that check, which the search would otherwise learn edge by edge
+  /// in every state with the same neighbours (cached per neighbours' locations).
+  bool ApproachClear(const SymState& s, int robot, int node, int loc, int grasp);
   /// The cheap checks of `robot` setting `node` down at location `loc` at grasp `grasp`: reach,
   /// the gripper clear of the table, the homes clear, IK, the object resting there (cached).
   bool CheapPlace(int robot, int node, int loc, int grasp);
@@ -393,6 +398,7 @@ class TaskSearch {
   int tally_round_ = 0;
   std::unordered_map<std::uint64_t, bool> homes_clear_;  // HomesClear per (node, location)
   std::unordered_map<std::uint64_t, bool> hands_apart_;  // HandsApart answers
+  std::vector<std::pair<int, Iso3>> approach_others_;  // ApproachClear's scratch
   // What GraspsApart reads of a grasp (by grasp id), computed once: its TCP position and
   // approach axis in the assembly frame, and whether its object is small (under 15 cm across).
   struct GraspAxis {

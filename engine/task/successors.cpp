@@ -137,7 +137,7 @@ void TaskSearch::PickSuccessors(const SymState& s, int robot, int node, std::spa
   const int16_t loc = s.loc[node];
   if (loc < 0 || s.NumHolders(node) != 0) return;
   for (int grasp : grasps) {
-    if (!CheapPick(robot, node, loc, grasp)) continue;
+    if (!CheapPick(robot, node, loc, grasp) || !ApproachClear(s, robot, node, loc, grasp)) continue;
     TaskAction a = ActionOn(ActionType::kPick, robot, node);
     a.grasp = grasp;
     Push(s, a, out);
@@ -158,7 +158,10 @@ void TaskSearch::AddGraspSuccessors(const SymState& s, const Milestone& m, bool 
       if (s.held[q] == node && !HandsApart(q, s.grasp[q], robot, grasp)) apart = false;
     }
     if (!apart) continue;
-    if (loc >= 0 && !CheapPick(robot, node, loc, grasp)) continue;
+    if (loc >= 0 &&
+        (!CheapPick(robot, node, loc, grasp) || !ApproachClear(s, robot, node, loc, grasp))) {
+      continue;
+    }
     TaskAction a = ActionOn(ActionType::kAddGrasp, robot, node);
     a.grasp = grasp;
     Push(s, a, out);
