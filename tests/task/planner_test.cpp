@@ -240,21 +240,44 @@ const std::vector<std::string> kExamplePlans = {
 INSTANTIATE_TEST_SUITE_P(Projects, ExamplePlan, ::testing::ValuesIn(kExamplePlans),
                          [](const auto& param_info) { return param_info.param; });
 
+// A tail case: `project` planned at `seed` without a time limit, the plan solved and accepted by
+// the validator (each failure reported); `loaded` false when the project does not load (the
+// Fabrica meshes are not beside the repository).
+struct TailRun {
+  bool loaded = false;
+  bool valid = false;
+  PlanStats stats;
+};
+
+TailRun PlanTail(const std::string& project, int seed) {
+  TailRun tail;
+  const fs::path file = ProjectFile(project);
+  const LoadedProject lp = LoadProject(file);
+  tail.loaded = lp.ok();
+  if (!tail.loaded) return tail;
+  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, seed, kNoTimeLimit);
+  if (!run.plan) {
+    ADD_FAILURE() << run.plan.error().message;
+    return tail;
+  }
+  tail.stats = run.plan->stats;
+  EXPECT_TRUE(tail.stats.solved) << tail.stats.failure;
+  EXPECT_TRUE(run.validation.has_value());
+  if (run.validation) EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
+  tail.valid = tail.stats.solved && run.validation && run.validation->valid;
+  return tail;
+}
+
 // A resolution level whose few grasps admit no assembly the keyframes can hold gives up after
 // kLevelAssemblyFailures failed assembly edges and widens, instead of spending its whole work
 // budget: the plumber's block seed 6 expanded 50,167 nodes at its first level before (1.1 s
 // against the other seeds' 0.03 s), a few hundred now. Counts, not times.
 TEST(WrapPlanTails, ALevelWhoseAssembliesKeepFailingWidensEarly) {
-  const fs::path file = ProjectFile("fabrica_plumbers_block");
-  const LoadedProject lp = LoadProject(file);
-  if (!lp.ok()) GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 6, kNoTimeLimit);
-  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
-  ASSERT_TRUE(run.plan->stats.solved) << run.plan->stats.failure;
-  ASSERT_TRUE(run.validation.has_value());
-  EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
-  EXPECT_GE(run.plan->stats.widenings, 1);
-  EXPECT_LT(run.plan->stats.expansions, 5000);
+  const TailRun tail = PlanTail("fabrica_plumbers_block", 6);
+  if (!tail.loaded) GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
+  ASSERT_TRUE(tail.valid);
+  EXPECT_GE(tail.stats.widenings, 1);
+  EXPECT_LT(tail.stats.expansions, 5000);
 }
 
 // A milestone whose first level searches its whole graph in vain from the end of the milestone
@@ -263,31 +286,21 @@ TEST(WrapPlanTails, ALevelWhoseAssembliesKeepFailingWidensEarly) {
 // proving at the wider levels that no plan leaves from there took 183k expansions (1.9 s against
 // the other seeds' 0.07 s). Counts, not times.
 TEST(WrapPlanTails, ADeadEndMilestoneStartIsLeftBeforeWidening) {
-  const fs::path file = ProjectFile("stool");
-  const LoadedProject lp = LoadProject(file);
-  ASSERT_TRUE(lp.ok());
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 1, kNoTimeLimit);
-  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
-  ASSERT_TRUE(run.plan->stats.solved) << run.plan->stats.failure;
-  ASSERT_TRUE(run.validation.has_value());
-  EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
-  EXPECT_GE(run.plan->stats.backtracks, 1);
-  EXPECT_LT(run.plan->stats.expansions, 30000);
+  const TailRun tail = PlanTail("stool", 1);
+  ASSERT_TRUE(tail.loaded);
+  ASSERT_TRUE(tail.valid);
+  EXPECT_GE(tail.stats.backtracks, 1);
+  EXPECT_LT(tail.stats.expansions, 30000);
 }
 
 // A pick whose gripper would run into a neighbour is not proposed (ApproachClear): the cube 2x2x3's
 // seed 3 learned such blocked approaches edge by edge (108 of the 114 failed edges of its second
 // milestone's first level) and spent that level's 50k expansions; now it plans in about 21k.
 TEST(WrapPlanTails, BlockedApproachesAreNotProposed) {
-  const fs::path file = ProjectFile("cube_2x2x3");
-  const LoadedProject lp = LoadProject(file);
-  ASSERT_TRUE(lp.ok());
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 3, kNoTimeLimit);
-  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
-  ASSERT_TRUE(run.plan->stats.solved) << run.plan->stats.failure;
-  ASSERT_TRUE(run.validation.has_value());
-  EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
-  EXPECT_LT(run.plan->stats.expansions, 40000);
+  const TailRun tail = PlanTail("cube_2x2x3", 3);
+  ASSERT_TRUE(tail.loaded);
+  ASSERT_TRUE(tail.valid);
+  EXPECT_LT(tail.stats.expansions, 40000);
 }
 
 // A level that is not the last and whose search finds no candidate plan at all within
@@ -295,16 +308,11 @@ TEST(WrapPlanTails, BlockedApproachesAreNotProposed) {
 // the abstraction promising 3 actions (every grasp of the subset puts a gripper into the wheel
 // when mated), and the widest level then found a plan in 35.
 TEST(WrapPlanTails, ALevelWithoutACandidateWidensAfterItsBlindBudget) {
-  const fs::path file = ProjectFile("fabrica_car");
-  const LoadedProject lp = LoadProject(file);
-  if (!lp.ok()) GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
-  const PlanRun run = PlanAndValidate(*lp.project, lp.check, file, 0, kNoTimeLimit);
-  ASSERT_TRUE(run.plan.has_value()) << run.plan.error().message;
-  ASSERT_TRUE(run.plan->stats.solved) << run.plan->stats.failure;
-  ASSERT_TRUE(run.validation.has_value());
-  EXPECT_TRUE(run.validation->valid) << Issues(*run.validation);
-  EXPECT_GE(run.plan->stats.widenings, 2);
-  EXPECT_LT(run.plan->stats.expansions, 20000);
+  const TailRun tail = PlanTail("fabrica_car", 0);
+  if (!tail.loaded) GTEST_SKIP() << "the Fabrica meshes are not beside the repository";
+  ASSERT_TRUE(tail.valid);
+  EXPECT_GE(tail.stats.widenings, 2);
+  EXPECT_LT(tail.stats.expansions, 20000);
 }
 
 // When the backward abstraction cannot reach a step's assembly, WRAP says why at once instead of
