@@ -213,7 +213,7 @@ void TaskSearch::BackwardRestAssembly(const Milestone& m, BackwardTables& t) {
         const WrenchObject objs[2] = {{m.moved, X, m_rests, mh}, {m.base, X, true, {}}};
         std::string why;
         best = solver_.Wrench(WrenchGate::kAssembly, objs, m.step,
-                              AssemblyLpKey(m.step, loc, mh, {}), &why)
+                              AssemblyLpKey(m.step, loc, solver_.ClassHolders(mh), {}), &why)
                    ? 1
                    : 2;
       }
@@ -242,7 +242,9 @@ void TaskSearch::BackwardAirAssembly(const Milestone& m, BackwardTables& t) {
           }
           const std::vector<std::pair<int, int>> mh = {{rm, gm}}, bh = {{rb, gb}};
           std::string why;
-          if (solver_.AirAssemblyPossible(m.step, mh, bh, CheapAssembleKey(m.step, -1, mh, bh),
+          if (solver_.AirAssemblyPossible(m.step, mh, bh,
+                                          CheapAssembleKey(m.step, -1, solver_.ClassHolders(mh),
+                                                           solver_.ClassHolders(bh)),
                                           &why)) {
             out = 1;
           }

@@ -77,8 +77,9 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
     // Transport right after the lift: deterministic, so checked here.
     const WrenchObject obj{node, X_WA, false, {{robot, grasp}}};
     std::string why;
-    const std::uint64_t lp_key =
-        HashMix(HashMix(HashMix(1, static_cast<std::uint64_t>(loc) + 100), robot), grasp);
+    const std::uint64_t lp_key = HashMix(
+        HashMix(HashMix(1, static_cast<std::uint64_t>(loc) + 100), solver_.WrenchClass(robot)),
+        grasp);
     ok = solver_.Wrench(WrenchGate::kTransport, {&obj, 1}, -1, lp_key, &why);
     if (!ok) tally_.Add(Gate::kWrenchTransport, why, about);
   }
@@ -294,12 +295,16 @@ bool TaskSearch::CheapAssemble(const SymState& s, const Milestone& m) {
     if (ok) {
       const bool m_rests = std::abs(LowestPoint(world_, m.moved, X_WB) - world_.table_top) <= 2e-3;
       const WrenchObject objs[2] = {{m.moved, X_WB, m_rests, mh}, {m.base, X_WB, true, bh}};
-      ok = solver_.Wrench(WrenchGate::kAssembly, objs, m.step,
-                          AssemblyLpKey(m.step, s.loc[m.base], mh, bh), &why);
+      ok = solver_.Wrench(
+          WrenchGate::kAssembly, objs, m.step,
+          AssemblyLpKey(m.step, s.loc[m.base], solver_.ClassHolders(mh), solver_.ClassHolders(bh)),
+          &why);
       if (!ok) tally_.Add(Gate::kWrenchAssembly, why, about(r0, g0, m.moved, -1));
     }
   } else {
-    ok = solver_.AirAssemblyPossible(m.step, mh, bh, key, &why);
+    ok = solver_.AirAssemblyPossible(
+        m.step, mh, bh,
+        CheapAssembleKey(m.step, -1, solver_.ClassHolders(mh), solver_.ClassHolders(bh)), &why);
     if (!ok) tally_.Add(Gate::kWrenchAssembly, why, about(r0, g0, m.moved, -1));
   }
   Remember(key, ok);

@@ -106,7 +106,7 @@ void KeyframeSolver::BuildPick(Edge& e, Problem& p) {
   p.gates = [this, &a, &s = e.s, o](const std::vector<Iso3>& X, Gate& g, std::string& why) {
     const WrenchObject obj{o, X[o], false, {{a.r1, a.grasp}}};
     const std::uint64_t key =
-        HashMix(HashMix(HashMix(1, static_cast<std::uint64_t>(s.loc[o]) + 100), a.r1),
+        HashMix(HashMix(HashMix(1, static_cast<std::uint64_t>(s.loc[o]) + 100), WrenchClass(a.r1)),
                 static_cast<std::uint64_t>(a.grasp));
     if (!Wrench(WrenchGate::kTransport, {&obj, 1}, -1, key, &why)) {
       g = Gate::kWrenchTransport;
@@ -135,7 +135,7 @@ void KeyframeSolver::BuildPlace(Edge& e, Problem& p) {
     // Brought down to that pose by its holder alone (the same problem as a pick from it).
     const WrenchObject carried{o, X[o], false, {{a.r1, s.grasp[a.r1]}}};
     const std::uint64_t key =
-        HashMix(HashMix(HashMix(1, static_cast<std::uint64_t>(a.loc) + 100), a.r1),
+        HashMix(HashMix(HashMix(1, static_cast<std::uint64_t>(a.loc) + 100), WrenchClass(a.r1)),
                 static_cast<std::uint64_t>(s.grasp[a.r1]));
     if (!Wrench(WrenchGate::kTransport, {&carried, 1}, -1, key, &why)) {
       g = Gate::kWrenchTransport;
@@ -294,7 +294,7 @@ void KeyframeSolver::BuildAssemble(Edge& e, Problem& p) {
                                   {B, X[B], b_rests, b_holders}};
     std::uint64_t key = 0;
     if (b_rests) {
-      key = AssemblyLpKey(o, e.s.loc[B], m_holders, b_holders);
+      key = AssemblyLpKey(o, e.s.loc[B], ClassHolders(m_holders), ClassHolders(b_holders));
     }
     if (!Wrench(WrenchGate::kAssembly, objs, o, key, &why)) {
       g = Gate::kWrenchAssembly;

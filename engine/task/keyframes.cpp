@@ -78,6 +78,16 @@ KeyframeSolver::KeyframeSolver(const TaskWorld& world, TaskTables& tables,
   for (size_t r = 0; r < world.robots.size(); ++r) {
     frames_[r].resize(world.robots[r].chain.links.size());
   }
+  for (size_t r = 0; r < world.robots.size(); ++r) {
+    const TaskRobot& a = world.robots[r];
+    int q = 0;
+    while (q < static_cast<int>(r) &&
+           !(world.robots[q].grasp_set == a.grasp_set && world.robots[q].limits == a.limits &&
+             world.robots[q].end_effector.kind == a.end_effector.kind)) {
+      ++q;
+    }
+    wrench_class_.push_back(q);
+  }
   part_object_.assign(world.num_parts, -1);
   // Finger boxes as bodies of their own, so that each keyframe opens them to its grasp.
   fingers_.resize(world.robots.size());
@@ -291,9 +301,29 @@ Result<WrenchCheck> KeyframeSolver::CountedCheck(WrenchGate gate, std::uint64_t 
   return result;
 }
 
+std::vector<std::pair<int, int>> KeyframeSolver::ClassHolders(
+    std::vector<std::pair<int, int>> holders) const {
+  for (auto& [robot, grasp] : holders) robot = wrench_class_[robot];
+  std::sort(holders.begin(), holders.end());
+  return holders;
+}
+
 bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objects, int mating_step,
                             std::uint64_t key, std::string* reason) {
   if (options_.wrench_mode == MatingWrenchMode::kNone) return true;
+  const std::uint64_t class_key = key;
+  if (key != 0) {
+    if (class_feasible_.contains(class_key)) {
+      ++counters_.lp_checks;
+      ++counters_.lp_cache_hits;
+      return true;
+    }
+    // The answer's words name the robots: cached per robots that hold, in order.
+    for (const WrenchObject& o : objects) {
+      for (const auto& [robot, grasp] : o.holders) key = HashMix(key, robot + 1);
+    }
+    key = HashMix(key, 0x686f6c64657273ULL);
+  }
   const StepConfiguration config = BuildWrenchConfig(world_, tables_, objects, mating_step);
   auto result = CountedCheck(gate, key, config);
   if (!result) {
@@ -301,6 +331,10 @@ bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objec
     return false;
   }
   if (!result->feasible && reason) *reason = result->reason;
+  if (result->feasible && class_key != 0) {
+    if (class_feasible_.size() >= (1u << 20)) class_feasible_.clear();
+    class_feasible_.insert(class_key);
+  }
   return result->feasible;
 }
 

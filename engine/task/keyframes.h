@@ -12,6 +12,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 #include "robot/cell.h"
@@ -133,8 +134,16 @@ class KeyframeSolver {
                   std::string* why);
   /// Finger opening of a robot holding with `grasp` (width plus clearance).
   double GraspOpening(int grasp) const;
-  /// The wrench gate for `objects` (cached by `key`, which must identify the question), with the
-  /// reason when infeasible. Mode none: always true.
+  /// Robots alike in the wrench LP (the same end effector, grasp set and wrench limits) share a
+  /// class: the first such robot's index. The LP cache keys of the search name holders by it.
+  int WrenchClass(int robot) const { return wrench_class_[robot]; }
+  /// `holders` ((robot, grasp id) pairs) with each robot replaced by its wrench class, sorted.
+  std::vector<std::pair<int, int>> ClassHolders(std::vector<std::pair<int, int>> holders) const;
+  /// The wrench gate for `objects` (cached by `key`, which must identify the question with its
+  /// holders named by WrenchClass, or 0: then by the question's content), with the reason when
+  /// infeasible. A feasible answer holds for every robot of the class; an infeasible one is
+  /// asked again for other robots of it, so that its reason names the robots that hold. Mode
+  /// none: always true.
   bool Wrench(WrenchGate gate, std::span<const WrenchObject> objects, int mating_step,
               std::uint64_t key, std::string* reason);
   /// Whether some orientation of the candidate set lets the assembly LP of `step` hold with the
@@ -224,6 +233,8 @@ class KeyframeSolver {
   const TaskPlannerOptions& options_;
   Cell cell_;
   TaskCounters& counters_;
+  std::vector<int> wrench_class_;  // WrenchClass per robot
+  std::unordered_set<std::uint64_t> class_feasible_;  // class keys answered feasible
   WrenchChecker checker_;
   std::vector<std::vector<Iso3>> frames_;  // per robot scratch FK frames
   std::vector<int> part_object_;           // scratch: object index of each part in SetScene

@@ -177,6 +177,60 @@ TEST(KeyframeSolver, ApproachesIntoARestingNeighbourAreRefusedCheaply) {
   EXPECT_GT(passed, 0);
 }
 
+// Robots alike in the wrench LP share its answers: in the cube 2x2x3's cell (four UR10e with the
+// same vacuum cup and limits) a feasible question asked for one robot is answered from the cache
+// for another, while an infeasible one is asked again, so that its reason names the robot that
+// holds (here every assembly fails: the mating force is scaled a thousandfold).
+TEST(KeyframeSolver, RobotsAlikeShareWrenchAnswersButNotReasons) {
+  SolverRig rig;
+  ASSERT_EQ(rig.Build("cube_2x2x3"), "");
+  const TaskWorld& world = *rig.world;
+  KeyframeSolver& solver = *rig.solver;
+  ASSERT_EQ(world.robots.size(), 4u);
+  for (int r = 0; r < 4; ++r) EXPECT_EQ(solver.WrenchClass(r), 0);
+  const std::vector<std::pair<int, int>> holders = {{3, 7}, {1, 2}};
+  const std::vector<std::pair<int, int>> classes = {{0, 2}, {0, 7}};
+  EXPECT_EQ(solver.ClassHolders(holders), classes);
+
+  // A transport: the first part lifted where it rests, by robot 0 and then robot 2.
+  const int part = 0;
+  const GraspSet* set = world.grasp_set(part, 0);
+  ASSERT_NE(set, nullptr);
+  ASSERT_FALSE(set->grasps.empty());
+  const Grasp& g = set->grasps[0];
+  const int id = rig.tables.Grasp(part, 0, GraspRef{part, 0, g.part, g.X_PG, g.width_m, g.quality});
+  Iso3 lifted = world.initial_X_WA[part];
+  lifted.translation().z() += 0.1;
+  const std::uint64_t key = HashMix(HashMix(HashMix(1, 777), solver.WrenchClass(0)), id);
+  std::string why;
+  const WrenchObject by0{part, lifted, false, {{0, id}}};
+  ASSERT_TRUE(solver.Wrench(WrenchGate::kTransport, {&by0, 1}, -1, key, &why)) << why;
+  const long long solves = rig.counters.lp_solves, hits = rig.counters.lp_cache_hits;
+  const WrenchObject by2{part, lifted, false, {{2, id}}};
+  EXPECT_TRUE(solver.Wrench(WrenchGate::kTransport, {&by2, 1}, -1, key, &why)) << why;
+  EXPECT_EQ(rig.counters.lp_solves, solves);
+  EXPECT_EQ(rig.counters.lp_cache_hits, hits + 1);
+
+  // An assembly whose mating force no vacuum cup can take: each robot's own reason.
+  const int step = world.tree->step_order.front();
+  const StepInterface& st = world.interface(step);
+  const GraspSet* moved_set = world.grasp_set(st.moved, 0);
+  ASSERT_NE(moved_set, nullptr);
+  ASSERT_FALSE(moved_set->grasps.empty());
+  const Grasp& gm = moved_set->grasps[0];
+  const int mid = rig.tables.Grasp(st.moved, 0,
+                                   GraspRef{st.moved, 0, gm.part, gm.X_PG, gm.width_m, gm.quality});
+  const Iso3 X = world.initial_X_WA[st.base];
+  rig.options.force_scale = 1000.0;
+  const std::uint64_t asm_key = AssemblyLpKey(step, 1, solver.ClassHolders({{1, mid}}), {});
+  for (int r : {1, 3}) {
+    const WrenchObject objs[2] = {{st.moved, X, false, {{r, mid}}}, {st.base, X, true, {}}};
+    why.clear();
+    EXPECT_FALSE(solver.Wrench(WrenchGate::kAssembly, objs, step, asm_key, &why));
+    EXPECT_NE(why.find(world.robots[r].name), std::string::npos) << why;
+  }
+}
+
 // Motion feedback: an edge that the motion stage could not make is never taken again. The
 // stool planned again with the first plan's first action banned gets another first action, and
 // its plan is still valid.
