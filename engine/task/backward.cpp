@@ -242,10 +242,10 @@ void TaskSearch::BackwardAirAssembly(const Milestone& m, BackwardTables& t) {
           }
           const std::vector<std::pair<int, int>> mh = {{rm, gm}}, bh = {{rb, gb}};
           std::string why;
-          if (solver_.AirAssemblyPossible(m.step, mh, bh,
-                                          CheapAssembleKey(m.step, -1, solver_.ClassHolders(mh),
-                                                           solver_.ClassHolders(bh)),
-                                          &why)) {
+          if (solver_.AirAssemblyPossible(
+                  m.step, mh, bh,
+                  CheapAssembleKey(m.step, -1, solver_.ClassHolders(mh), solver_.ClassHolders(bh)),
+                  &why)) {
             out = 1;
           }
           break;  // one LP family per moved grasp: the base grasps differ little

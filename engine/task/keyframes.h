@@ -233,7 +233,7 @@ class KeyframeSolver {
   const TaskPlannerOptions& options_;
   Cell cell_;
   TaskCounters& counters_;
-  std::vector<int> wrench_class_;  // WrenchClass per robot
+  std::vector<int> wrench_class_;                     // WrenchClass per robot
   std::unordered_set<std::uint64_t> class_feasible_;  // class keys answered feasible
   WrenchChecker checker_;
   std::vector<std::vector<Iso3>> frames_;  // per robot scratch FK frames

@@ -216,7 +216,8 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
     // BENCHMARKS.md) before the next level, which usually solves it at once.
     // Until its search finds a first candidate plan, such a level gets kBlindExpansions: the
     // abstraction promised a short way the forward graph does not have.
-    const long long budget = limits.level_expansions > 0 ? limits.level_expansions : kLevelExpansions;
+    const long long budget =
+        limits.level_expansions > 0 ? limits.level_expansions : kLevelExpansions;
     level_full_cap_ =
         level + 1 < levels ? expansions_ + budget : std::numeric_limits<long long>::max();
     level_cap_ = level + 1 < levels ? expansions_ + std::min(budget, kBlindExpansions)
@@ -263,8 +264,8 @@ MilestoneResult TaskSearch::Fill(int index, int step, int next_step, const SymSt
     if (level == limits.first_level &&
         (limits.first_level_only ||
          (limits.stop_when_first_exhausted && expansions_ <= level_cap_ && !optimistic_))) {
-      finish();
       result.first_level_exhausted = expansions_ <= level_cap_;
+      finish();
       result.failure = words + ": nothing at resolution level " + std::to_string(level) + "; " +
                        tally_.Summary();
       return result;

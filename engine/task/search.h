@@ -368,7 +368,7 @@ class TaskSearch {
   /// then: kBlindExpansions).
   long long level_full_cap_ = std::numeric_limits<long long>::max();
   int level_assembly_failures_ = 0;  // failed assembly edges at this level (lazy_search.cpp)
-  std::size_t rss0_ = 0;  ///< Resident memory when the search was made [bytes].
+  std::size_t rss0_ = 0;             ///< Resident memory when the search was made [bytes].
   /// Steps of the window assembled in `s` (they are assembled in order).
   int WindowDone(const SymState& s) const;
   std::vector<Node> nodes_;
@@ -398,7 +398,7 @@ class TaskSearch {
   int tally_round_ = 0;
   std::unordered_map<std::uint64_t, bool> homes_clear_;  // HomesClear per (node, location)
   std::unordered_map<std::uint64_t, bool> hands_apart_;  // HandsApart answers
-  std::vector<std::pair<int, Iso3>> approach_others_;  // ApproachClear's scratch
+  std::vector<std::pair<int, Iso3>> approach_others_;    // ApproachClear's scratch
   // What GraspsApart reads of a grasp (by grasp id), computed once: its TCP position and
   // approach axis in the assembly frame, and whether its object is small (under 15 cm across).
   struct GraspAxis {

@@ -168,8 +168,8 @@ TEST(KeyframeSolver, ApproachesIntoARestingNeighbourAreRefusedCheaply) {
         next.grasp[robot] = id;
         next.loc[part] = kInAir;
         const EdgeOutcome out = solver.Validate(s, c, a, next, 2, 1);
-        EXPECT_FALSE(out.ok) << world.tree->nodes[part].name << " grasp " << i << " robot "
-                             << robot << ": the cheap check refused a pick the keyframes allow";
+        EXPECT_FALSE(out.ok) << world.tree->nodes[part].name << " grasp " << i << " robot " << robot
+                             << ": the cheap check refused a pick the keyframes allow";
       }
     }
   }
