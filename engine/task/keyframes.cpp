@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 #include "robot/kinematics.h"
 #include "task/keyframes_internal.h"
@@ -73,7 +74,7 @@ KeyframeSolver::KeyframeSolver(const TaskWorld& world, TaskTables& tables,
       cell_(std::move(cell)),
       counters_(counters),
       checker_(WrenchOptions{.first_failure_suffices = true,
-                              .on_question = options.wrench_question_observer}) {
+                             .on_question = options.wrench_question_observer}) {
   frames_.resize(world.robots.size());
   for (size_t r = 0; r < world.robots.size(); ++r) {
     frames_[r].resize(world.robots[r].chain.links.size());
@@ -308,21 +309,57 @@ std::vector<std::pair<int, int>> KeyframeSolver::ClassHolders(
   return holders;
 }
 
+namespace {
+
+// The robots holding `objects`, object by object, each object's in the order of (wrench class,
+// grasp): the order in which two questions of one class key name their robots alike.
+std::vector<int> RobotsInClassOrder(std::span<const WrenchObject> objects,
+                                    const std::vector<int>& wrench_class) {
+  std::vector<int> robots;
+  for (const WrenchObject& o : objects) {
+    std::vector<std::tuple<int, int, int>> held;
+    for (const auto& [robot, grasp] : o.holders)
+      held.emplace_back(wrench_class[robot], grasp, robot);
+    std::sort(held.begin(), held.end());
+    for (const auto& h : held) robots.push_back(std::get<2>(h));
+  }
+  return robots;
+}
+
+// `text` with each quoted name of robots[i] replaced by that of to[i] (at once: names may swap).
+std::string Renamed(std::string text, const std::vector<int>& from, const std::vector<int>& to,
+                    const std::vector<TaskRobot>& robots) {
+  auto replace_all = [&text](const std::string& a, const std::string& b) {
+    for (std::size_t at = text.find(a); at != std::string::npos; at = text.find(a, at + b.size())) {
+      text.replace(at, a.size(), b);
+    }
+  };
+  for (std::size_t i = 0; i < from.size() && i < to.size(); ++i) {
+    if (from[i] != to[i])
+      replace_all("'" + robots[from[i]].name + "'", "'\x01" + std::to_string(i) + "'");
+  }
+  for (std::size_t i = 0; i < from.size() && i < to.size(); ++i) {
+    if (from[i] != to[i])
+      replace_all("'\x01" + std::to_string(i) + "'", "'" + robots[to[i]].name + "'");
+  }
+  return text;
+}
+
+}  // namespace
+
 bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objects, int mating_step,
                             std::uint64_t key, std::string* reason) {
   if (options_.wrench_mode == MatingWrenchMode::kNone) return true;
-  const std::uint64_t class_key = key;
   if (key != 0) {
-    if (class_feasible_.contains(class_key)) {
+    if (auto it = class_answers_.find(key); it != class_answers_.end()) {
       ++counters_.lp_checks;
       ++counters_.lp_cache_hits;
-      return true;
+      if (!it->second.feasible && reason) {
+        *reason = Renamed(it->second.reason, it->second.robots,
+                          RobotsInClassOrder(objects, wrench_class_), world_.robots);
+      }
+      return it->second.feasible;
     }
-    // The answer's words name the robots: cached per robots that hold, in order.
-    for (const WrenchObject& o : objects) {
-      for (const auto& [robot, grasp] : o.holders) key = HashMix(key, robot + 1);
-    }
-    key = HashMix(key, 0x686f6c64657273ULL);
   }
   const StepConfiguration config = BuildWrenchConfig(world_, tables_, objects, mating_step);
   auto result = CountedCheck(gate, key, config);
@@ -331,9 +368,14 @@ bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objec
     return false;
   }
   if (!result->feasible && reason) *reason = result->reason;
-  if (result->feasible && class_key != 0) {
-    if (class_feasible_.size() >= (1u << 20)) class_feasible_.clear();
-    class_feasible_.insert(class_key);
+  if (key != 0) {
+    if (class_answers_.size() >= (1u << 20)) class_answers_.clear();
+    ClassAnswer& answer = class_answers_[key];
+    answer.feasible = result->feasible;
+    if (!answer.feasible) {
+      answer.reason = result->reason;
+      answer.robots = RobotsInClassOrder(objects, wrench_class_);
+    }
   }
   return result->feasible;
 }

@@ -12,6 +12,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
@@ -141,9 +142,8 @@ class KeyframeSolver {
   std::vector<std::pair<int, int>> ClassHolders(std::vector<std::pair<int, int>> holders) const;
   /// The wrench gate for `objects` (cached by `key`, which must identify the question with its
   /// holders named by WrenchClass, or 0: then by the question's content), with the reason when
-  /// infeasible. A feasible answer holds for every robot of the class; an infeasible one is
-  /// asked again for other robots of it, so that its reason names the robots that hold. Mode
-  /// none: always true.
+  /// infeasible. An answer serves every robot of the class; a reason is renamed to the robots
+  /// that hold. Mode none: always true.
   bool Wrench(WrenchGate gate, std::span<const WrenchObject> objects, int mating_step,
               std::uint64_t key, std::string* reason);
   /// Whether some orientation of the candidate set lets the assembly LP of `step` hold with the
@@ -233,8 +233,15 @@ class KeyframeSolver {
   const TaskPlannerOptions& options_;
   Cell cell_;
   TaskCounters& counters_;
-  std::vector<int> wrench_class_;                     // WrenchClass per robot
-  std::unordered_set<std::uint64_t> class_feasible_;  // class keys answered feasible
+  std::vector<int> wrench_class_;  // WrenchClass per robot
+  // Wrench answers by class key: feasible, or the reason with the robots it names (the holders
+  // in class order), renamed for the robots of a later question.
+  struct ClassAnswer {
+    bool feasible = true;
+    std::string reason;
+    std::vector<int> robots;
+  };
+  std::unordered_map<std::uint64_t, ClassAnswer> class_answers_;
   WrenchChecker checker_;
   std::vector<std::vector<Iso3>> frames_;  // per robot scratch FK frames
   std::vector<int> part_object_;           // scratch: object index of each part in SetScene
