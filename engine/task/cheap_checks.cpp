@@ -87,19 +87,27 @@ bool TaskSearch::CheapPick(int robot, int node, int loc, int grasp) {
   return ok;
 }
 
-bool TaskSearch::ApproachClear(const SymState& s, int robot, int node, int loc, int grasp) {
-  std::uint64_t key = HashMix(HashMix(HashMix(HashMix(105, robot), node), loc), grasp);
+std::uint64_t TaskSearch::RestingNeighbours(const SymState& s, int node) const {
+  std::uint64_t h = 105;
+  for (int n = 0; n < world_.num_nodes; ++n) {
+    if (n != node && s.loc[n] >= 0)
+      h = HashMix(HashMix(h, n), static_cast<std::uint64_t>(s.loc[n]));
+  }
+  return h;
+}
+
+bool TaskSearch::ApproachClear(const SymState& s, std::uint64_t neighbours, int robot, int node,
+                               int loc, int grasp) {
+  const std::uint64_t key = HashMix(HashMix(HashMix(HashMix(neighbours, robot), node), loc), grasp);
+  if (int* index = cheap_.find(key)) return Recall(cheap_answers_[*index]);
   std::vector<std::pair<int, Iso3>>& others = approach_others_;
   others.clear();
   for (int n = 0; n < world_.num_nodes; ++n) {
-    if (n == node || s.loc[n] < 0) continue;
-    key = HashMix(HashMix(key, n), static_cast<std::uint64_t>(s.loc[n]));
-    others.push_back({n, tables_.location(s.loc[n]).X_WA});
+    if (n != node && s.loc[n] >= 0) others.push_back({n, tables_.location(s.loc[n]).X_WA});
   }
-  if (others.empty()) return true;
-  if (int* index = cheap_.find(key)) return Recall(cheap_answers_[*index]);
   int hit = -1;
-  const bool ok = solver_.ApproachClear(robot, grasp, tables_.location(loc).X_WA, others, &hit);
+  const bool ok = others.empty() ||
+                  solver_.ApproachClear(robot, grasp, tables_.location(loc).X_WA, others, &hit);
   if (!ok) {
     CheckSubject about{.object = node, .robot = robot, .grasp = grasp, .loc = loc};
     about.hit_node = hit;

@@ -300,11 +300,16 @@ class TaskSearch {
   /// The cheap checks of `robot` picking `node` resting at location `loc` at grasp `grasp`:
   /// reach, the gripper clear of the table, IK, carrying it right after the lift (cached).
   bool CheapPick(int robot, int node, int loc, int grasp);
+  /// The objects resting in `s` other than `node`, and where (a hash): what ApproachClear's
+  /// answer depends on besides the robot and the grasp, computed once per state and node.
+  std::uint64_t RestingNeighbours(const SymState& s, int node) const;
   /// The gripper of `robot` approaching grasp `grasp` of `node` resting at `loc` straight along
   /// its axis (the approach the keyframe check asks for) clear of the other objects resting in
-  /// `s`: a necessary condition of that check, which the search would otherwise learn edge by edge
-  /// in every state with the same neighbours (cached per neighbours' locations).
-  bool ApproachClear(const SymState& s, int robot, int node, int loc, int grasp);
+  /// `s` (`neighbours`: RestingNeighbours(s, node)): a necessary condition of that check, which
+  /// the search would otherwise learn edge by edge in every state with the same neighbours
+  /// (cached per neighbours' locations).
+  bool ApproachClear(const SymState& s, std::uint64_t neighbours, int robot, int node, int loc,
+                     int grasp);
   /// The cheap checks of `robot` setting `node` down at location `loc` at grasp `grasp`: reach,
   /// the gripper clear of the table, the homes clear, IK, the object resting there (cached).
   bool CheapPlace(int robot, int node, int loc, int grasp);

@@ -136,8 +136,12 @@ void TaskSearch::PickSuccessors(const SymState& s, int robot, int node, std::spa
   // Pick a resting object nobody holds.
   const int16_t loc = s.loc[node];
   if (loc < 0 || s.NumHolders(node) != 0) return;
+  const std::uint64_t neighbours = RestingNeighbours(s, node);
   for (int grasp : grasps) {
-    if (!CheapPick(robot, node, loc, grasp) || !ApproachClear(s, robot, node, loc, grasp)) continue;
+    if (!CheapPick(robot, node, loc, grasp) ||
+        !ApproachClear(s, neighbours, robot, node, loc, grasp)) {
+      continue;
+    }
     TaskAction a = ActionOn(ActionType::kPick, robot, node);
     a.grasp = grasp;
     Push(s, a, out);
@@ -152,14 +156,15 @@ void TaskSearch::AddGraspSuccessors(const SymState& s, const Milestone& m, bool 
   const bool brace = loc >= 0 && node == m.base && !done;
   const bool carry = loc == kInAir && holders >= 1;
   if (!(brace || carry) || holders >= options_.max_holders) return;
+  const std::uint64_t neighbours = loc >= 0 ? RestingNeighbours(s, node) : 0;
   for (int grasp : grasps) {
     bool apart = true;
     for (int q = 0; q < n_robots_; ++q) {
       if (s.held[q] == node && !HandsApart(q, s.grasp[q], robot, grasp)) apart = false;
     }
     if (!apart) continue;
-    if (loc >= 0 &&
-        (!CheapPick(robot, node, loc, grasp) || !ApproachClear(s, robot, node, loc, grasp))) {
+    if (loc >= 0 && (!CheapPick(robot, node, loc, grasp) ||
+                     !ApproachClear(s, neighbours, robot, node, loc, grasp))) {
       continue;
     }
     TaskAction a = ActionOn(ActionType::kAddGrasp, robot, node);
