@@ -283,7 +283,7 @@ bool KeyframeSolver::SoloReach(int robot, const std::vector<PlanObject>& objects
 }
 
 Result<WrenchCheck> KeyframeSolver::CountedCheck(WrenchGate gate, std::uint64_t key,
-                                                 const StepConfiguration& config) {
+                                                 const StepConfiguration& config, bool uncached) {
   ++counters_.lp_checks;
   const auto start = Clock::now();
   WrenchQuery query;
@@ -293,8 +293,9 @@ Result<WrenchCheck> KeyframeSolver::CountedCheck(WrenchGate gate, std::uint64_t 
   const std::uint64_t hits = checker_.cache_hits();
   const std::uint64_t solves = checker_.lp_solves();
   const std::uint64_t pivots = checker_.lp_pivots();
-  auto result =
-      key != 0 ? checker_.CheckCached(key, config, query) : checker_.CheckCached(config, query);
+  auto result = uncached   ? checker_.Check(config, query)
+                : key != 0 ? checker_.CheckCached(key, config, query)
+                           : checker_.CheckCached(config, query);
   counters_.t_lp_s += Seconds(start);
   counters_.lp_cache_hits += static_cast<long long>(checker_.cache_hits() - hits);
   counters_.lp_solves += static_cast<long long>(checker_.lp_solves() - solves);
@@ -362,7 +363,8 @@ bool KeyframeSolver::Wrench(WrenchGate gate, std::span<const WrenchObject> objec
     }
   }
   const StepConfiguration config = BuildWrenchConfig(world_, tables_, objects, mating_step);
-  auto result = CountedCheck(gate, key, config);
+  // A keyed answer is kept in class_answers_ alone.
+  auto result = CountedCheck(gate, key, config, /*uncached=*/key != 0);
   if (!result) {
     if (reason) *reason = result.error().message;
     return false;

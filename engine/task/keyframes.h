@@ -211,10 +211,11 @@ class KeyframeSolver {
   /// Assemble: the insertion from the approach pose is reachable and clear (t.approach).
   bool InsertionClear(Edge& e, const Problem& p, Attempt& t, const std::vector<JointVector>& q);
 
-  /// The checker's answer for `config` at `gate` (cached by `key`, 0: by content), counted in
+  /// The checker's answer for `config` at `gate` (cached by `key`, 0: by content; not through
+  /// the checker's cache when `uncached`, for a caller that keeps the answer itself), counted in
   /// the counters (checks, hits, LPs, pivots, t_lp).
   Result<WrenchCheck> CountedCheck(WrenchGate gate, std::uint64_t key,
-                                   const StepConfiguration& config);
+                                   const StepConfiguration& config, bool uncached = false);
   bool SolveIk(int robot, const Iso3& X_WT, const JointVector& reference, int effort,
                std::mt19937_64& rng, std::vector<JointVector>& out);
   void SetScene(const std::vector<PlanObject>& objects,
