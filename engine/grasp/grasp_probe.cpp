@@ -10,14 +10,6 @@
 
 namespace wrap {
 
-namespace {
-
-// Reduced candidates wanted per part, as a multiple of GraspProbeOptions::candidates (as the
-// preprocessing's second draw for a part short of assembly grasps: their features are small).
-constexpr int kReducedPoolFactor = 16;
-
-}  // namespace
-
 struct GraspProbe::Impl {
   std::vector<EndEffector> effectors;
   std::vector<Iso3> X_AP;
@@ -120,8 +112,9 @@ int GraspProbe::ReducedClearOf(int part, int ee, std::span<const int> others) {
     in.ee = &impl.effectors[ee];
     in.ee_index = ee;
     in.friction = impl.options.friction;
-    in.wanted = kReducedPoolFactor * impl.options.candidates;
-    in.max_samples = kReducedPoolFactor / 4 * impl.options.candidates * impl.options.sample_factor;
+    in.wanted = detail::kShortReducedPoolFactor * impl.options.candidates;
+    in.max_samples =
+        detail::kShortReducedPoolFactor / 4 * impl.options.candidates * impl.options.sample_factor;
     RunContext quiet(impl.options.seed);
     reduced.emplace();
     for (const detail::GraspCandidate& c :

@@ -27,10 +27,9 @@ using detail::GraspCandidate;
 using Clock = std::chrono::steady_clock;
 
 // A part with reduced grasps and fewer than this many candidates (of any type) clear of its
-// partner at the mating pose draws reduced candidates a second time, kShortPoolFactor times the
-// full-pad pool (4 times round 0's samples).
+// partner at the mating pose draws reduced candidates a second time, kShortReducedPoolFactor
+// times the full-pad pool (4 times round 0's samples).
 constexpr int kLeastAssemblyGrasps = 8;
-constexpr int kShortPoolFactor = 16;
 
 // SplitMix64 of a and b: independent seeds for the tasks of one run.
 std::uint64_t MixSeed(std::uint64_t a, std::uint64_t b) {
@@ -328,7 +327,7 @@ std::vector<char> ReducedRoundParts(const PreprocessOptions& options,
 
 // Adds reduced (partial-pad, fingertip) candidates to the two-finger candidates of the unique
 // parts marked in `needs` (ReducedRoundParts), with a generator of each round's own and a pool
-// of 4 times the full-pad one in round 0, kShortPoolFactor times it in round 1. Returns the
+// of 4 times the full-pad one in round 0, kShortReducedPoolFactor times it in round 1. Returns the
 // parts that got them (every part sharing a marked mesh).
 std::vector<char> AddReducedCandidates(const PreprocessOptions& options,
                                        const std::vector<EndEffector>& effectors,
@@ -348,7 +347,7 @@ std::vector<char> AddReducedCandidates(const PreprocessOptions& options,
     const std::uint64_t salt = round == 0 ? 0x9e3779b97f4a7c15ULL : 0xc2b2ae3d27d4eb4fULL;
     std::mt19937_64 rng(MixSeed(out.seed, salt ^ (static_cast<std::uint64_t>(task) + 1)));
     // A larger pool: the features only reduced grasps hold are small (a collar, a button).
-    const int factor = round == 0 ? 4 : kShortPoolFactor;
+    const int factor = round == 0 ? 4 : detail::kShortReducedPoolFactor;
     detail::SamplerInput in = SamplerInputFor(sampled, effectors, out, p, e);
     in.wanted = factor * sampled.pool;
     in.max_samples = factor / 4 * sampled.max_samples;

@@ -45,6 +45,11 @@ std::vector<GraspCandidate> SampleTwoFinger(const SamplerInput& in,
                                             GripperCollision& world, std::mt19937_64& rng,
                                             const RunContext& ctx);
 
+/// The pool of a reduced draw for a part short of grasps, as a multiple of the full-pad pool
+/// (with a quarter of that multiple times the samples): their features are small (a collar, a
+/// button). Preprocessing's second draw and GraspProbe::ReducedClearOf both use it.
+inline constexpr int kShortReducedPoolFactor = 16;
+
 /// Reduced two-finger sampling (partial-pad and fingertip grasps, grasp.h GraspType): as
 /// SampleTwoFinger, on a finer pad grid, trying first the approach straight down in the
 /// assembly's frame, with the pads centred on the contacts touching less than
